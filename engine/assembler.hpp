@@ -1,0 +1,57 @@
+#pragma once
+// Global residual and sparse tangent with a pattern fixed at construction. Each component's
+// local system is scattered through a precomputed map into the compressed matrix values, so
+// assembly allocates nothing and never rebuilds the pattern.
+#include "component.hpp"
+#include "model.hpp"
+
+#include <Eigen/Sparse>
+
+#include <vector>
+
+namespace mpx {
+
+class Assembler {
+ public:
+  explicit Assembler(const Model& model);
+
+  // Zero residual, tangent values and the flows of the evaluation.
+  void clear();
+  // Evaluate every component with evaluate(component, workspace, local, flows) and add the
+  // result times `weight` (trapezoidal rule: two evaluations of weight 1/2).
+  template <class Evaluate>
+  void add(const Model& model, Workspace& ws, double weight, const Evaluate& evaluate) {
+    const auto& components = model.components();
+    for (std::size_t c = 0; c < components.size(); ++c) {
+      LocalSystem local{static_cast<int>(components[c]->dofs().size()), localResidual_.data(), localTangent_.data()};
+      std::fill_n(local.r, local.n, 0.0);
+      std::fill_n(local.k, local.n * local.n, 0.0);
+      Flows componentFlows;
+      evaluate(*components[c], ws, local, componentFlows);
+      scatter(c, components[c]->dofs(), local, weight);
+      flows_.dissipated += weight * componentFlows.dissipated;
+      flows_.externalWork += weight * componentFlows.externalWork;
+      flows_.boundaryHeat += weight * componentFlows.boundaryHeat;
+    }
+  }
+
+  const Eigen::VectorXd& residual() const { return residual_; }
+  const Eigen::SparseMatrix<double>& tangent() const { return tangent_; }
+  const Flows& flows() const { return flows_; }
+  // max_i |R_i| / sum_j |K_ij| stateScale_j: each residual row relative to the change its
+  // terms make over the state's magnitude, so rows of any unit compare alike.
+  double relativeResidualNorm(const Eigen::VectorXd& stateScale);
+
+ private:
+  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);
+
+  Eigen::VectorXd residual_;
+  Eigen::VectorXd rowScale_;
+  Eigen::SparseMatrix<double> tangent_;
+  Flows flows_;
+  std::vector<std::vector<int>> valueIndex_;  // per component: n*n positions in tangent_ values
+  std::vector<double> localResidual_;
+  std::vector<double> localTangent_;
+};
+
+}  // namespace mpx

@@ -1,0 +1,109 @@
+#pragma once
+// The one interface every physical effect implements. A component touches a fixed list of
+// state dofs (its local dofs); the engine evaluates it on preallocated local buffers and
+// scatters the result. Energy, entropy and momenta of the system are plain sums over components.
+#include <Eigen/Dense>
+
+#include <string>
+#include <vector>
+
+namespace mpx {
+
+using Vec3 = Eigen::Vector3d;
+
+// Largest number of local dofs of one component (two mass points, thermal and internal
+// variables, or a heat link between two such elements).
+inline constexpr int kMaxLocalDofs = 32;
+
+// Temperature of a thermal node as seen by the heat links that touch it: the discrete
+// temperature theta~ in an EEM step, theta(z) in a rate evaluation. The owner publishes it
+// together with its derivative with respect to the owner's local dofs, already multiplied
+// by the coefficient the tangent applies to z-derivatives (1 in EEM, alpha in rate form).
+struct NodeTemperature {
+  double value = 0.0;
+  int count = 0;  // number of owner-local dofs in grad (0 for a prescribed temperature)
+  double grad[kMaxLocalDofs] = {};
+};
+
+// Scratch shared by the components of one evaluation, allocated once per model.
+struct Workspace {
+  std::vector<NodeTemperature> nodes;
+};
+
+// One EEM step from zOld at time t to zNew at time t + dt.
+struct StepArgs {
+  const double* zOld;
+  const double* zNew;
+  double t;
+  double dt;
+};
+
+// A rate evaluation F(t, z, zdot); the tangent wanted is alpha dF/dz + beta dF/dzdot.
+struct RateArgs {
+  const double* z;
+  const double* zdot;
+  double t;
+  double alpha;
+  double beta;
+};
+
+// Power crossing the system boundary or leaving the mechanical energy (W): viscous power
+// without a thermal node, power of time-dependent external loads, heat through prescribed
+// temperatures into the system.
+struct Flows {
+  double dissipated = 0.0;
+  double externalWork = 0.0;
+  double boundaryHeat = 0.0;
+};
+
+// Local residual r (n) and tangent K (n x n, column-major), zeroed before each evaluation.
+struct LocalSystem {
+  int n = 0;
+  double* r = nullptr;
+  double* k = nullptr;
+  Eigen::Map<Eigen::VectorXd> residual() { return {r, n}; }
+  Eigen::Map<Eigen::MatrixXd> tangent() { return {k, n, n}; }
+};
+
+// A row vector over the local dofs of one component (fixed capacity: no heap).
+using LocalRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxLocalDofs>;
+
+// What the history reports about one state.
+struct Measures {
+  double energy = 0.0;
+  double entropy = 0.0;
+  Vec3 momentum = Vec3::Zero();
+  Vec3 angularMomentum = Vec3::Zero();
+  double constraintViolation = 0.0;
+  std::vector<double> nodeTemperature;  // one entry per thermal node
+};
+
+class Component {
+ public:
+  virtual ~Component() = default;
+
+  // Global state indices of the local dofs, in local order.
+  const std::vector<int>& dofs() const { return dofs_; }
+  // Name used in messages and output.
+  const std::string& name() const { return name_; }
+  // Coupling components (heat links) read node temperatures published by the others, so
+  // they are evaluated after all non-coupling components.
+  virtual bool isCoupling() const { return false; }
+
+  // Add energy, entropy, momenta and node temperatures of state z.
+  virtual void measure(const double* z, Measures& out) const = 0;
+  // EEM step residual (rate form, ~ F(t + dt/2, z_mid, (zNew - zOld)/dt)) and its derivative
+  // with respect to zNew.
+  virtual void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const = 0;
+  // Continuous residual F(t, z, zdot) and alpha dF/dz + beta dF/dzdot.
+  virtual void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const = 0;
+
+ protected:
+  Component(std::string name, std::vector<int> dofs) : name_(std::move(name)), dofs_(std::move(dofs)) {}
+
+ private:
+  std::string name_;
+  std::vector<int> dofs_;
+};
+
+}  // namespace mpx

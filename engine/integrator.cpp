@@ -1,0 +1,103 @@
+#include "integrator.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace mpx {
+
+Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings settings)
+    : model_(model),
+      scheme_(scheme),
+      settings_(settings),
+      assembler_(model),
+      workspace_(model.makeWorkspace()),
+      zMid_(model.layout().total()),
+      zDot_(model.layout().total()),
+      increment_(model.layout().total()),
+      halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())) {}
+
+Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
+  assembler_.clear();
+  if (scheme_ == Scheme::Eem) {
+    const StepArgs args{zOld.data(), zNew.data(), t, dt};
+    assembler_.add(model_, workspace_, 1.0, [&](const Component& c, Workspace& ws, LocalSystem& l, Flows& f) {
+      c.eemLocal(args, ws, l, f);
+    });
+    return assembler_;
+  }
+  zDot_ = (zNew - zOld) / dt;
+  auto rate = [this](const RateArgs& args, double weight) {
+    assembler_.add(model_, workspace_, weight, [&](const Component& c, Workspace& ws, LocalSystem& l, Flows& f) {
+      c.rateLocal(args, ws, l, f);
+    });
+  };
+  // midpoint: F(t + dt/2, (z + z')/2, (z' - z)/dt)
+  if (scheme_ == Scheme::Midpoint) {
+    zMid_ = 0.5 * (zOld + zNew);
+    rate({zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5, 1.0 / dt}, 1.0);
+    return assembler_;
+  }
+  // trapezoidal: mean of F at both end points with the same (z' - z)/dt
+  rate({zOld.data(), zDot_.data(), t, 0.0, 1.0 / dt}, 0.5);
+  rate({zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
+  return assembler_;
+}
+
+bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
+                           StepOutcome& outcome) {
+  const Eigen::VectorXd& scale = model_.dofScale();
+  zNew = zOld;
+  double incrementNorm = INFINITY;
+  for (int iteration = 0;; ++iteration) {
+    Assembler& system = evaluate(zOld, zNew, t, dt);
+    stateScale_ = zNew.cwiseAbs() + scale;
+    const double residualNorm = system.relativeResidualNorm(stateScale_);
+    if (!std::isfinite(residualNorm)) {
+      outcome.failure = "non-finite residual";
+      return false;
+    }
+    if (iteration > 0 && incrementNorm <= settings_.incrementTolerance &&
+        residualNorm <= settings_.residualTolerance) {
+      const Flows& flows = system.flows();
+      outcome.energy.dissipated += dt * flows.dissipated;
+      outcome.energy.externalWork += dt * flows.externalWork;
+      outcome.energy.boundaryHeat += dt * flows.boundaryHeat;
+      return true;
+    }
+    if (iteration == settings_.maxIterations) {
+      char text[160];
+      std::snprintf(text, sizeof text, "Newton did not converge in %d iterations (increment %.3g, residual %.3g)",
+                    iteration, incrementNorm, residualNorm);
+      outcome.failure = text;
+      return false;
+    }
+    if (!solver_.factorize(system.tangent())) {
+      outcome.failure = "singular tangent";
+      return false;
+    }
+    increment_ = -system.residual();
+    solver_.solve(increment_);
+    zNew += increment_;
+    ++outcome.iterations;
+    incrementNorm = (increment_.array().abs() / (zNew.array().abs() + scale.array())).maxCoeff();
+  }
+}
+
+bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
+                              StepOutcome& outcome) {
+  if (solveStep(z, t, dt, zNew, outcome)) return true;
+  if (level == settings_.maxCutbacks) return false;
+  // cut back: two half steps through an intermediate state of this level
+  ++outcome.cutbacks;
+  Eigen::VectorXd& half = halfState_[level];
+  return advanceLevel(z, t, 0.5 * dt, level + 1, half, outcome) &&
+         advanceLevel(half, t + 0.5 * dt, 0.5 * dt, level + 1, zNew, outcome);
+}
+
+StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew) {
+  StepOutcome outcome;
+  outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
+  return outcome;
+}
+
+}  // namespace mpx

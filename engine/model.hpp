@@ -1,0 +1,47 @@
+#pragma once
+// A model compiled once from a scene: dof layout, components (immutable parameters), names,
+// initial state. Everything that changes during a run lives in the state vector or in
+// workspaces owned by the integrator.
+#include "component.hpp"
+#include "layout.hpp"
+
+#include <Eigen/Dense>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mpx {
+
+// Which thermal variable the Thermal block holds.
+enum class ThermalVariable { Temperature, Entropy };
+
+class Model {
+ public:
+  Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
+        std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale);
+
+  const Layout& layout() const { return layout_; }
+  ThermalVariable thermalVariable() const { return thermalVariable_; }
+  // Non-coupling components first, then couplings (see Component::isCoupling).
+  const std::vector<std::unique_ptr<Component>>& components() const { return components_; }
+  const std::vector<std::string>& thermalNodeNames() const { return thermalNodeNames_; }
+  const Eigen::VectorXd& initialState() const { return initialState_; }
+  // Characteristic magnitude of each dof, used to weigh Newton increments.
+  const Eigen::VectorXd& dofScale() const { return dofScale_; }
+
+  // Energy, entropy, momenta and node temperatures of state z; `out` is reused (no allocation
+  // once sized).
+  void measure(const Eigen::VectorXd& z, Measures& out) const;
+  Workspace makeWorkspace() const;
+
+ private:
+  Layout layout_;
+  ThermalVariable thermalVariable_;
+  std::vector<std::unique_ptr<Component>> components_;
+  std::vector<std::string> thermalNodeNames_;
+  Eigen::VectorXd initialState_;
+  Eigen::VectorXd dofScale_;
+};
+
+}  // namespace mpx

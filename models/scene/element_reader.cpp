@@ -1,0 +1,99 @@
+#include "element_reader.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace mpx {
+
+ElementReader::ElementReader(const tinyxml2::XMLElement& element, const std::string& file)
+    : element_(element), file_(file) {}
+
+void ElementReader::fail(const std::string& message) const {
+  std::string where = std::string("<") + element_.Name();
+  if (const char* name = element_.Attribute("name")) where += std::string(" name=\"") + name + "\"";
+  throw InputError(file_, element_.GetLineNum(), where + ">: " + message);
+}
+
+bool ElementReader::has(const char* attribute) const { return element_.Attribute(attribute) != nullptr; }
+
+const char* ElementReader::raw(const char* attribute) {
+  read_.insert(attribute);
+  return element_.Attribute(attribute);
+}
+
+std::string ElementReader::text(const char* attribute) {
+  const char* value = raw(attribute);
+  if (!value) fail(std::string("missing required attribute '") + attribute + "'");
+  return value;
+}
+
+std::string ElementReader::text(const char* attribute, const std::string& fallback) {
+  const char* value = raw(attribute);
+  return value ? value : fallback;
+}
+
+double ElementReader::parseNumber(const char* attribute, const std::string& token) const {
+  char* end = nullptr;
+  const double value = std::strtod(token.c_str(), &end);
+  if (token.empty() || *end != '\0') fail(std::string("attribute '") + attribute + "': '" + token + "' is not a number");
+  if (!std::isfinite(value)) fail(std::string("attribute '") + attribute + "' must be finite, got '" + token + "'");
+  return value;
+}
+
+double ElementReader::number(const char* attribute) {
+  const std::string token = text(attribute);
+  return parseNumber(attribute, token);
+}
+
+double ElementReader::number(const char* attribute, double fallback) {
+  return has(attribute) ? number(attribute) : (read_.insert(attribute), fallback);
+}
+
+double ElementReader::positive(const char* attribute) {
+  const double value = number(attribute);
+  if (!(value > 0.0)) fail(std::string("attribute '") + attribute + "' must be positive, got " + text(attribute));
+  return value;
+}
+
+double ElementReader::positive(const char* attribute, double fallback) {
+  return has(attribute) ? positive(attribute) : (read_.insert(attribute), fallback);
+}
+
+double ElementReader::nonNegative(const char* attribute, double fallback) {
+  const double value = number(attribute, fallback);
+  if (value < 0.0) fail(std::string("attribute '") + attribute + "' must not be negative, got " + text(attribute));
+  return value;
+}
+
+int ElementReader::count(const char* attribute, int fallback) {
+  const double value = number(attribute, fallback);
+  if (value < 0 || value != std::floor(value))
+    fail(std::string("attribute '") + attribute + "' must be a non-negative integer");
+  return static_cast<int>(value);
+}
+
+std::vector<double> ElementReader::numbers(const char* attribute) {
+  std::istringstream stream(text(attribute));
+  std::vector<double> values;
+  for (std::string token; stream >> token;) values.push_back(parseNumber(attribute, token));
+  return values;
+}
+
+Vec3 ElementReader::vector(const char* attribute, const Vec3& fallback) {
+  if (!has(attribute)) {
+    read_.insert(attribute);
+    return fallback;
+  }
+  const std::vector<double> values = numbers(attribute);
+  if (values.size() != 3)
+    fail(std::string("attribute '") + attribute + "' needs 3 numbers, got " + std::to_string(values.size()));
+  return {values[0], values[1], values[2]};
+}
+
+void ElementReader::finish() const {
+  for (const tinyxml2::XMLAttribute* a = element_.FirstAttribute(); a; a = a->Next())
+    if (!read_.count(a->Name())) fail(std::string("unknown attribute '") + a->Name() + "'");
+}
+
+}  // namespace mpx

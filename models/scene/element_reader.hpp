@@ -1,0 +1,49 @@
+#pragma once
+// Typed, validated access to the attributes of one XML element. Every value is checked
+// (finite numbers, signs, vector length) and every attribute must be read: finish() rejects
+// the ones left over, so a misspelt attribute is an error, not a silent default.
+#include "engine/component.hpp"
+#include "engine/input_error.hpp"
+
+#include <tinyxml2.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace mpx {
+
+class ElementReader {
+ public:
+  ElementReader(const tinyxml2::XMLElement& element, const std::string& file);
+
+  bool has(const char* attribute) const;
+  std::string text(const char* attribute);
+  std::string text(const char* attribute, const std::string& fallback);
+  double number(const char* attribute);
+  double number(const char* attribute, double fallback);
+  // A number that must be > 0 (positive) or >= 0 (nonNegative).
+  double positive(const char* attribute);
+  double positive(const char* attribute, double fallback);
+  double nonNegative(const char* attribute, double fallback);
+  int count(const char* attribute, int fallback);
+  Vec3 vector(const char* attribute, const Vec3& fallback);
+  std::vector<double> numbers(const char* attribute);
+
+  // Throw an InputError naming the file, line, element and `message`.
+  [[noreturn]] void fail(const std::string& message) const;
+  // Reject attributes that were never read.
+  void finish() const;
+  const std::string& file() const { return file_; }
+  int line() const { return element_.GetLineNum(); }
+
+ private:
+  const char* raw(const char* attribute);
+  double parseNumber(const char* attribute, const std::string& token) const;
+
+  const tinyxml2::XMLElement& element_;
+  std::string file_;
+  std::set<std::string> read_;
+};
+
+}  // namespace mpx

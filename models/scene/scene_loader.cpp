@@ -1,0 +1,412 @@
+#include "scene_loader.hpp"
+
+#include "element_reader.hpp"
+#include "models/damper.hpp"
+#include "models/external_force.hpp"
+#include "models/fixed_temperature.hpp"
+#include "models/heat_link.hpp"
+#include "models/point_mass.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace mpx {
+
+namespace {
+
+using tinyxml2::XMLElement;
+
+// Scene elements that own a thermal dof or an internal variable: counted before the main
+// pass so the state layout (and thus every global dof index) is known while reading.
+bool ownsThermalDof(const std::string& tag) {
+  return tag == "thermo_spring" || tag == "thermo_maxwell" || tag == "reservoir";
+}
+bool ownsInternalDof(const std::string& tag) { return tag == "maxwell" || tag == "thermo_maxwell"; }
+
+class SceneCompiler {
+ public:
+  SceneCompiler(const XMLElement& root, std::string file, std::optional<ThermalVariable> thermalVariable)
+      : root_(root), file_(std::move(file)), thermalOverride_(thermalVariable) {}
+
+  CompiledScene compile();
+
+ private:
+  void readSettings();
+  void readSimulation(ElementReader& in);
+  void readSolver(ElementReader& in);
+  void addElement(const XMLElement& element);
+  void addMass(ElementReader& in);
+  void addAnchor(ElementReader& in);
+  void addSpring(ElementReader& in, bool withBranch);
+  void addDamper(ElementReader& in);
+  void addThermoElement(ElementReader& in, bool withBranch);
+  void addReservoir(ElementReader& in);
+  void addFixedTemperature(ElementReader& in);
+  void addHeatLink(ElementReader& in);
+  void addForce(ElementReader& in);
+
+  std::string declareName(ElementReader& in);
+  Endpoint endpoint(ElementReader& in, const char* attribute);
+  std::pair<Endpoint, Endpoint> endpoints(ElementReader& in);
+  ThermalNodeRef thermalNode(ElementReader& in, const char* attribute);
+  int nextThermalDof(const std::string& name, double scale, int& node);
+  // Add a lumped element; its local dofs are what its published node temperature refers to.
+  void addLumpedElement(LumpedElementSpec spec);
+  Vec3 positionOf(const Endpoint& end) const;
+  void keepPositionScale(double length) { positionScale_ = std::max(positionScale_, length); }
+
+  const XMLElement& root_;
+  std::string file_;
+  std::optional<ThermalVariable> thermalOverride_;
+  SceneSettings settings_;
+  ThermalVariable variable_ = ThermalVariable::Temperature;
+  Vec3 gravity_ = Vec3::Zero();
+
+  Layout layout_;
+  Eigen::VectorXd state_, scale_;
+  std::vector<std::unique_ptr<Component>> components_;
+  std::vector<std::string> thermalNodeNames_;
+  std::map<std::string, Endpoint> points_;  // masses and anchors
+  std::map<std::string, ThermalNodeRef> thermalNodes_;
+  std::map<std::string, int> names_;  // every declared name -> line
+  int massCount_ = 0, thermalCount_ = 0, internalCount_ = 0;
+  double positionScale_ = 0.0;
+};
+
+CompiledScene SceneCompiler::compile() {
+  if (std::string(root_.Name()) != "metriplex")
+    throw InputError(file_, root_.GetLineNum(),
+                     std::string("the root element must be <metriplex>, found <") + root_.Name() + ">");
+  readSettings();
+
+  // the layout from a count of what owns dofs
+  int masses = 0, thermal = 0, internal = 0;
+  for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Name();
+    masses += tag == "mass";
+    thermal += ownsThermalDof(tag);
+    internal += ownsInternalDof(tag);
+  }
+  layout_ = Layout({3 * masses, 3 * masses, thermal, internal, 0});
+  state_ = Eigen::VectorXd::Zero(layout_.total());
+  scale_ = Eigen::VectorXd::Zero(layout_.total());
+
+  for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) addElement(*e);
+
+  // Newton's increment scales: a length for positions, length per run time for velocities
+  const double length = positionScale_ > 0.0 ? positionScale_ : 1.0;
+  for (int i = 0; i < layout_.size(Block::Position); ++i) {
+    const int p = layout_.dof(Block::Position, i), v = layout_.dof(Block::Velocity, i);
+    scale_[p] = std::max(scale_[p], length);
+    scale_[v] = std::max(std::abs(state_[v]), length / settings_.tEnd);
+  }
+  auto model = std::make_unique<Model>(layout_, variable_, std::move(components_), thermalNodeNames_, state_, scale_);
+  return {settings_, std::move(model)};
+}
+
+void SceneCompiler::readSettings() {
+  bool haveSimulation = false;
+  for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Name();
+    ElementReader in(*e, file_);
+    if (tag == "simulation") {
+      haveSimulation = true;
+      readSimulation(in);
+    } else if (tag == "solver") {
+      readSolver(in);
+    } else if (tag == "gravity") {
+      gravity_ = in.vector("g", Vec3::Zero());
+      in.finish();
+    }
+  }
+  if (!haveSimulation)
+    throw InputError(file_, root_.GetLineNum(), "<metriplex>: missing <simulation dt=... t_end=...> element");
+  settings_.name = root_.Attribute("name") ? root_.Attribute("name") : "scene";
+  variable_ = thermalOverride_.value_or(settings_.thermalVariable);
+}
+
+void SceneCompiler::readSimulation(ElementReader& in) {
+  settings_.dt = in.positive("dt");
+  settings_.tEnd = in.positive("t_end");
+  settings_.integrator = in.text("integrator", "eem");
+  const std::string variable = in.text("thermal_variable", "temperature");
+  if (variable != "temperature" && variable != "entropy")
+    in.fail("thermal_variable must be 'temperature' or 'entropy', got '" + variable + "'");
+  settings_.thermalVariable = variable == "entropy" ? ThermalVariable::Entropy : ThermalVariable::Temperature;
+  const std::string form = in.text("discrete_gradient", "partitioned");
+  if (form != "partitioned" && form != "gonzalez")
+    in.fail("discrete_gradient must be 'partitioned' or 'gonzalez', got '" + form + "'");
+  settings_.discreteGradient = form == "gonzalez" ? DiscreteGradientForm::Gonzalez : DiscreteGradientForm::Partitioned;
+  in.finish();
+}
+
+void SceneCompiler::readSolver(ElementReader& in) {
+  NewtonSettings& n = settings_.newton;
+  n.incrementTolerance = in.positive("increment_tolerance", n.incrementTolerance);
+  n.residualTolerance = in.positive("residual_tolerance", n.residualTolerance);
+  n.maxIterations = in.count("max_iterations", n.maxIterations);
+  n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks);
+  if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
+  in.finish();
+}
+
+void SceneCompiler::addElement(const XMLElement& element) {
+  const std::string tag = element.Name();
+  ElementReader in(element, file_);
+  if (tag == "simulation" || tag == "solver" || tag == "gravity") return;  // read by readSettings
+  if (tag == "mass") addMass(in);
+  else if (tag == "anchor") addAnchor(in);
+  else if (tag == "spring") addSpring(in, false);
+  else if (tag == "maxwell") addSpring(in, true);
+  else if (tag == "damper") addDamper(in);
+  else if (tag == "thermo_spring") addThermoElement(in, false);
+  else if (tag == "thermo_maxwell") addThermoElement(in, true);
+  else if (tag == "reservoir") addReservoir(in);
+  else if (tag == "fixed_temperature") addFixedTemperature(in);
+  else if (tag == "heat_link") addHeatLink(in);
+  else if (tag == "force") addForce(in);
+  else in.fail("unknown element (see docs/scene-format.md for the elements a scene may hold)");
+  in.finish();
+}
+
+std::string SceneCompiler::declareName(ElementReader& in) {
+  const std::string name = in.text("name");
+  if (name.empty()) in.fail("name must not be empty");
+  const auto [it, inserted] = names_.emplace(name, in.line());
+  if (!inserted) in.fail("name '" + name + "' is already used on line " + std::to_string(it->second));
+  return name;
+}
+
+Endpoint SceneCompiler::endpoint(ElementReader& in, const char* attribute) {
+  const std::string name = in.text(attribute);
+  const auto it = points_.find(name);
+  if (it == points_.end())
+    in.fail(std::string("attribute '") + attribute + "': no mass or anchor named '" + name +
+            "' declared above this element");
+  return it->second;
+}
+
+Vec3 SceneCompiler::positionOf(const Endpoint& end) const {
+  return end.isMass() ? Vec3(state_.segment<3>(end.positionDof)) : end.anchor;
+}
+
+std::pair<Endpoint, Endpoint> SceneCompiler::endpoints(ElementReader& in) {
+  const Endpoint a = endpoint(in, "a"), b = endpoint(in, "b");
+  const double length = (positionOf(b) - positionOf(a)).norm();
+  if (!(length > 0.0)) in.fail("end points 'a' and 'b' coincide: the element has no direction");
+  keepPositionScale(length);
+  return {a, b};
+}
+
+ThermalNodeRef SceneCompiler::thermalNode(ElementReader& in, const char* attribute) {
+  const std::string name = in.text(attribute);
+  const auto it = thermalNodes_.find(name);
+  if (it == thermalNodes_.end())
+    in.fail(std::string("attribute '") + attribute + "': no thermal node named '" + name +
+            "' declared above (thermo_spring, thermo_maxwell, reservoir or fixed_temperature)");
+  return it->second;
+}
+
+int SceneCompiler::nextThermalDof(const std::string& name, double scale, int& node) {
+  const int dof = layout_.dof(Block::Thermal, thermalCount_++);
+  node = static_cast<int>(thermalNodeNames_.size());
+  thermalNodeNames_.push_back(name);
+  thermalNodes_[name] = ThermalNodeRef{node, dof, {}};
+  scale_[dof] = scale;
+  return dof;
+}
+
+void SceneCompiler::addLumpedElement(LumpedElementSpec spec) {
+  spec.form = settings_.discreteGradient;
+  auto element = std::make_unique<LumpedElement>(std::move(spec));
+  if (const auto node = thermalNodes_.find(element->name()); node != thermalNodes_.end())
+    node->second.ownerDofs = element->dofs();
+  components_.push_back(std::move(element));
+}
+
+void SceneCompiler::addMass(ElementReader& in) {
+  const std::string name = declareName(in);
+  const double mass = in.positive("mass");
+  const int index = massCount_++;
+  const Endpoint end{layout_.dof(Block::Position, 3 * index), layout_.dof(Block::Velocity, 3 * index), Vec3::Zero()};
+  state_.segment<3>(end.positionDof) = in.vector("position", Vec3::Zero());
+  state_.segment<3>(end.velocityDof) = in.vector("velocity", Vec3::Zero());
+  keepPositionScale(state_.segment<3>(end.positionDof).norm());
+  points_[name] = end;
+  components_.push_back(std::make_unique<PointMass>(name, mass, end.positionDof, end.velocityDof, gravity_));
+}
+
+void SceneCompiler::addAnchor(ElementReader& in) {
+  const std::string name = declareName(in);
+  Endpoint end;
+  end.anchor = in.vector("position", Vec3::Zero());
+  keepPositionScale(end.anchor.norm());
+  points_[name] = end;
+}
+
+void SceneCompiler::addSpring(ElementReader& in, bool withBranch) {
+  LumpedElementSpec spec;
+  spec.name = declareName(in);
+  spec.ends = endpoints(in);
+  const double stiffness = in.nonNegative("stiffness", 0.0);
+  const double restLength = in.positive("rest_length");
+  double branchStiffness = 0.0;
+  if (withBranch) {
+    branchStiffness = in.positive("branch_stiffness");
+    spec.viscosity.reference = in.positive("viscosity");
+    spec.internalDof = layout_.dof(Block::Internal, internalCount_++);
+    state_[spec.internalDof] = in.number("viscous_elongation", 0.0);
+    scale_[spec.internalDof] = restLength;
+  }
+  if (!withBranch && !(stiffness > 0.0)) in.fail("attribute 'stiffness' must be positive");
+  keepPositionScale(restLength);
+  spec.law = std::make_shared<HookeLaw>(stiffness, restLength, branchStiffness);
+  spec.argumentScale = Vec3(restLength * restLength, 1.0, restLength);
+  addLumpedElement(std::move(spec));
+}
+
+void SceneCompiler::addDamper(ElementReader& in) {
+  const std::string name = declareName(in);
+  const auto [a, b] = endpoints(in);
+  components_.push_back(std::make_unique<Damper>(name, a, b, in.positive("coefficient")));
+}
+
+void SceneCompiler::addThermoElement(ElementReader& in, bool withBranch) {
+  LumpedElementSpec spec;
+  spec.name = declareName(in);
+  spec.ends = endpoints(in);
+  ThermoElasticParameters p;
+  p.stiffness = in.positive("stiffness");
+  p.stiffnessSlope = in.number("stiffness_slope", 0.0);
+  p.stiffnessCurvature = in.number("stiffness_curvature", 0.0);
+  p.coupling = in.number("coupling", 0.0);
+  p.restLength = in.positive("rest_length");
+  p.heatCapacity = in.positive("heat_capacity");
+  p.referenceTemperature = in.positive("reference_temperature");
+  keepPositionScale(p.restLength);
+  const double thermalScale = variable_ == ThermalVariable::Temperature ? p.referenceTemperature : p.heatCapacity;
+  if (withBranch) {
+    p.branchStiffness = in.positive("branch_stiffness");
+    spec.viscosity = {in.positive("viscosity"), in.number("viscosity_activation", 0.0), p.referenceTemperature};
+  }
+
+  std::shared_ptr<ThermoElasticLaw> law;
+  try {
+    law = std::make_shared<ThermoElasticLaw>(p, variable_);
+  } catch (const std::invalid_argument& e) {
+    in.fail(e.what());
+  }
+  spec.law = law;
+  spec.thermalDof = nextThermalDof(spec.name, thermalScale, spec.thermalNode);
+  const double gamma = withBranch ? in.number("viscous_strain", 0.0) : 0.0;
+  if (withBranch) {
+    spec.internalDof = layout_.dof(Block::Internal, internalCount_++);
+    state_[spec.internalDof] = gamma;
+    scale_[spec.internalDof] = 1.0;
+  }
+
+  // initial thermal state from a temperature or an entropy, in the model's variable
+  const double c = (positionOf(spec.ends->second) - positionOf(spec.ends->first)).squaredNorm();
+  if (in.has("temperature") == in.has("entropy")) in.fail("give exactly one of 'temperature' and 'entropy'");
+  try {
+    state_[spec.thermalDof] = in.has("temperature")
+                                  ? law->thermalVariableFromTemperature(c, in.positive("temperature"), gamma)
+                                  : law->thermalVariableFromEntropy(c, in.number("entropy"), gamma);
+  } catch (const std::invalid_argument& e) {
+    in.fail(e.what());
+  }
+  spec.argumentScale = Vec3(p.restLength * p.restLength, thermalScale, 1.0);
+  addLumpedElement(std::move(spec));
+}
+
+void SceneCompiler::addReservoir(ElementReader& in) {
+  LumpedElementSpec spec;
+  spec.name = declareName(in);
+  ThermoElasticParameters p;
+  p.hasStretch = false;
+  p.heatCapacity = in.positive("heat_capacity");
+  if (in.has("temperature") == in.has("entropy")) in.fail("give exactly one of 'temperature' and 'entropy'");
+  p.referenceTemperature = in.positive("reference_temperature", in.has("temperature") ? in.positive("temperature") : 1.0);
+  const auto law = std::make_shared<ThermoElasticLaw>(p, variable_);
+  spec.law = law;
+  const double thermalScale = variable_ == ThermalVariable::Temperature ? p.referenceTemperature : p.heatCapacity;
+  spec.thermalDof = nextThermalDof(spec.name, thermalScale, spec.thermalNode);
+  state_[spec.thermalDof] = in.has("temperature") ? law->thermalVariableFromTemperature(0.0, in.positive("temperature"), 0.0)
+                                                  : law->thermalVariableFromEntropy(0.0, in.number("entropy"), 0.0);
+  spec.argumentScale = Vec3(1.0, thermalScale, 1.0);
+  addLumpedElement(std::move(spec));
+}
+
+void SceneCompiler::addFixedTemperature(ElementReader& in) {
+  const std::string name = declareName(in);
+  const int node = static_cast<int>(thermalNodeNames_.size());
+  thermalNodeNames_.push_back(name);
+  thermalNodes_[name] = ThermalNodeRef{node, -1, {}};
+  components_.push_back(std::make_unique<FixedTemperature>(name, node, in.positive("temperature")));
+}
+
+void SceneCompiler::addHeatLink(ElementReader& in) {
+  const std::string name = declareName(in);
+  ThermalNodeRef a = thermalNode(in, "a"), b = thermalNode(in, "b");
+  if (a.node == b.node) in.fail("a heat link needs two different thermal nodes");
+  if (a.thermalDof < 0 && b.thermalDof < 0) in.fail("a heat link between two fixed temperatures has no effect");
+  components_.push_back(std::make_unique<HeatLink>(name, std::move(a), std::move(b), in.positive("conductivity")));
+}
+
+void SceneCompiler::addForce(ElementReader& in) {
+  const std::string name = declareName(in);
+  const Endpoint on = endpoint(in, "on");
+  if (!on.isMass()) in.fail("attribute 'on' must name a mass, not an anchor");
+  const Vec3 force = in.vector("force", Vec3::Zero());
+  const std::string profile = in.text("profile", "constant");
+  TimeFunction f;
+  if (profile == "constant") {
+    f = TimeFunction::constant();
+  } else if (profile == "ramp") {
+    const double start = in.nonNegative("start", 0.0), end = in.positive("end");
+    if (!(end > start)) in.fail("ramp needs end > start");
+    f = TimeFunction::ramp(start, end);
+  } else if (profile == "hat") {
+    f = TimeFunction::hat(in.positive("period"));
+  } else if (profile == "table") {
+    std::vector<double> times = in.numbers("times"), values = in.numbers("values");
+    if (times.empty() || times.size() != values.size()) in.fail("'times' and 'values' need the same, non-zero count");
+    if (!std::is_sorted(times.begin(), times.end(), std::less_equal<>()) ||
+        std::adjacent_find(times.begin(), times.end()) != times.end())
+      in.fail("'times' must be strictly increasing");
+    f = TimeFunction::table(std::move(times), std::move(values));
+  } else {
+    in.fail("profile must be constant, ramp, hat or table, got '" + profile + "'");
+  }
+  components_.push_back(std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, std::move(f)));
+}
+
+CompiledScene compileDocument(tinyxml2::XMLDocument& document, const std::string& label,
+                              std::optional<ThermalVariable> thermalVariable) {
+  if (document.Error())
+    throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
+  const XMLElement* root = document.RootElement();
+  if (!root) throw InputError(label, 1, "the file holds no XML element");
+  return SceneCompiler(*root, label, thermalVariable).compile();
+}
+
+}  // namespace
+
+CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable) {
+  std::ifstream file(path);
+  if (!file) throw InputError(path + ": cannot open the scene file");
+  std::stringstream text;
+  text << file.rdbuf();
+  return loadSceneText(text.str(), path, thermalVariable);
+}
+
+CompiledScene loadSceneText(const std::string& text, const std::string& label,
+                            std::optional<ThermalVariable> thermalVariable) {
+  tinyxml2::XMLDocument document;
+  document.Parse(text.c_str(), text.size());
+  return compileDocument(document, label, thermalVariable);
+}
+
+}  // namespace mpx

@@ -1,0 +1,36 @@
+#pragma once
+// Compile an XML scene (docs/scene-format.md) into a Model. Scene-level defaults (step,
+// end time, integrator, solver settings) come back beside the model.
+#include "engine/integrator.hpp"
+#include "engine/model.hpp"
+#include "models/lumped_element.hpp"
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace mpx {
+
+struct SceneSettings {
+  std::string name;
+  double dt = 0.0;
+  double tEnd = 0.0;
+  std::string integrator = "eem";
+  ThermalVariable thermalVariable = ThermalVariable::Temperature;  // what the scene declares
+  DiscreteGradientForm discreteGradient = DiscreteGradientForm::Partitioned;
+  NewtonSettings newton;
+};
+
+struct CompiledScene {
+  SceneSettings settings;
+  std::unique_ptr<Model> model;
+};
+
+// Throws InputError (file, line, element, what is wrong) on any invalid input. When
+// thermalVariable is given it overrides the scene's choice (e.g. --integrator eem-entropy).
+CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable = std::nullopt);
+// The same from XML text; `label` stands for the file name in messages.
+CompiledScene loadSceneText(const std::string& text, const std::string& label,
+                            std::optional<ThermalVariable> thermalVariable = std::nullopt);
+
+}  // namespace mpx

@@ -1,0 +1,15 @@
+#!/bin/sh
+# Install the Debian 12 packages Metriplex builds, tests and plots with. Idempotent; run as root.
+set -eu
+packages="build-essential cmake pkg-config libeigen3-dev libsundials-dev libsuitesparse-dev
+  libopenblas0-pthread libtinyxml2-dev liburdfdom-dev libgtest-dev libbenchmark-dev libcli11-dev
+  libfmt-dev gnuplot-nox"
+missing=""
+for p in $packages; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends $missing
+fi
