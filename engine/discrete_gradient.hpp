@@ -27,9 +27,11 @@ struct DiscreteGradient {
   Mat3 dGradDb = Mat3::Zero();
 };
 
-// Relative increment below which a difference quotient is replaced by its midpoint limit:
-// the quotient then has a relative round-off error of about eps / kQuotientSwitch = 1e-9.
-inline constexpr double kQuotientSwitch = 1e-7;
+// Relative increment h below which a difference quotient is replaced by its midpoint limit.
+// Above it the quotient carries round-off eps/h (1e-11) and its derivative eps/h^2 (1e-6),
+// which keeps Newton's residual well below its tolerance; below it the midpoint derivative
+// breaks directionality by only O(h^3) = 1e-15 relative to the energy.
+inline constexpr double kQuotientSwitch = 1e-5;
 
 // True when b - a is too small, relative to the arguments and their scale, to divide by.
 inline bool isTinyIncrement(double a, double b, double scale) {
