@@ -58,14 +58,19 @@ void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, con
 }
 
 
-double Assembler::relativeResidualNorm(const Eigen::VectorXd& stateScale) {
+void Assembler::updateRowScale(const Eigen::VectorXd& stateScale) {
   rowScale_.setZero();
   for (int col = 0; col < tangent_.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(tangent_, col); it; ++it)
       rowScale_[it.row()] += std::abs(it.value()) * stateScale[col];
+}
+
+double Assembler::relativeResidualNorm() const {
   double norm = 0.0;
-  for (Eigen::Index i = 0; i < residual_.size(); ++i)
+  for (Eigen::Index i = 0; i < residual_.size(); ++i) {
+    if (!std::isfinite(residual_[i])) return INFINITY;
     if (residual_[i] != 0.0) norm = std::max(norm, std::abs(residual_[i]) / rowScale_[i]);
+  }
   return norm;
 }
 

@@ -38,9 +38,11 @@ class Assembler {
   const Eigen::VectorXd& residual() const { return residual_; }
   const Eigen::SparseMatrix<double>& tangent() const { return tangent_; }
   const Flows& flows() const { return flows_; }
-  // max_i |R_i| / sum_j |K_ij| stateScale_j: each residual row relative to the change its
-  // terms make over the state's magnitude, so rows of any unit compare alike.
-  double relativeResidualNorm(const Eigen::VectorXd& stateScale);
+  // Row scales sum_j |K_ij| stateScale_j: the change each residual row's terms make over the
+  // state's magnitude, so that rows of any unit compare alike.
+  void updateRowScale(const Eigen::VectorXd& stateScale);
+  // max_i |R_i| / rowScale_i with the last row scales; infinite if R is not finite.
+  double relativeResidualNorm() const;
 
  private:
   void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);

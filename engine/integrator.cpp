@@ -5,6 +5,11 @@
 
 namespace mpx {
 
+namespace {
+// Backtracking gives up (and the step is cut back) below this fraction of a Newton step.
+constexpr double kSmallestLineSearchStep = 1.0 / 1024;
+}  // namespace
+
 Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings settings)
     : model_(model),
       scheme_(scheme),
@@ -14,6 +19,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       zMid_(model.layout().total()),
       zDot_(model.layout().total()),
       increment_(model.layout().total()),
+      trial_(model.layout().total()),
       halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())) {}
 
 Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
@@ -46,16 +52,26 @@ Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::Vector
 bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
                            StepOutcome& outcome) {
   const Eigen::VectorXd& scale = model_.dofScale();
-  zNew = zOld;
-  double incrementNorm = INFINITY;
-  for (int iteration = 0;; ++iteration) {
-    Assembler& system = evaluate(zOld, zNew, t, dt);
+  auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
+    char text[200];
+    std::snprintf(text, sizeof text, "%s (Newton iteration %d, increment %.3g, residual %.3g)", what, iteration,
+                  incrementNorm, residualNorm);
+    outcome.failure = text;
+    return false;
+  };
+  // the residual norm relative to row scales taken at the current iterate
+  auto rescaledNorm = [&](Assembler& system) {
     stateScale_ = zNew.cwiseAbs() + scale;
-    const double residualNorm = system.relativeResidualNorm(stateScale_);
-    if (!std::isfinite(residualNorm)) {
-      outcome.failure = "non-finite residual";
-      return false;
-    }
+    system.updateRowScale(stateScale_);
+    return system.relativeResidualNorm();
+  };
+
+  zNew = zOld;
+  Assembler& system = evaluate(zOld, zNew, t, dt);
+  double residualNorm = rescaledNorm(system);
+  double incrementNorm = INFINITY;
+  if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
+  for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance &&
         residualNorm <= settings_.residualTolerance) {
       const Flows& flows = system.flows();
@@ -64,22 +80,30 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
       outcome.energy.boundaryHeat += dt * flows.boundaryHeat;
       return true;
     }
-    if (iteration == settings_.maxIterations) {
-      char text[160];
-      std::snprintf(text, sizeof text, "Newton did not converge in %d iterations (increment %.3g, residual %.3g)",
-                    iteration, incrementNorm, residualNorm);
-      outcome.failure = text;
-      return false;
-    }
-    if (!solver_.factorize(system.tangent())) {
-      outcome.failure = "singular tangent";
-      return false;
-    }
+    if (iteration == settings_.maxIterations)
+      return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
+    if (!solver_.factorize(system.tangent())) return fail("singular tangent", iteration, incrementNorm, residualNorm);
     increment_ = -system.residual();
     solver_.solve(increment_);
-    zNew += increment_;
+
+    // backtrack along the Newton direction until the residual is finite and decreases (a
+    // full step near the solution, where the residual is already at round-off level)
+    double step = 1.0;
+    for (;;) {
+      trial_ = zNew + step * increment_;
+      evaluate(zOld, trial_, t, dt);
+      const double trialNorm = system.relativeResidualNorm();
+      if (trialNorm <= (1.0 - 1e-4 * step) * residualNorm ||
+          (std::isfinite(trialNorm) && residualNorm <= settings_.residualTolerance))
+        break;
+      step *= 0.5;
+      if (step < kSmallestLineSearchStep)
+        return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
+    }
+    zNew.swap(trial_);
     ++outcome.iterations;
-    incrementNorm = (increment_.array().abs() / (zNew.array().abs() + scale.array())).maxCoeff();
+    incrementNorm = step * (increment_.array().abs() / (zNew.array().abs() + scale.array())).maxCoeff();
+    residualNorm = rescaledNorm(system);
   }
 }
 

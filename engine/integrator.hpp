@@ -1,7 +1,8 @@
 #pragma once
 // One-step integrators on a compiled model: the EEM discrete-gradient scheme and the standard
 // implicit midpoint and trapezoidal rules (derived from the components' rate form), solved by
-// Newton-Raphson with the consistent tangent and a bounded step cut-back.
+// Newton-Raphson with the consistent tangent, a backtracking line search on the residual and
+// a bounded step cut-back.
 #include "assembler.hpp"
 #include "klu_solver.hpp"
 #include "model.hpp"
@@ -60,7 +61,7 @@ class Integrator {
   Assembler assembler_;
   KluSolver solver_;
   Workspace workspace_;
-  Eigen::VectorXd zMid_, zDot_, increment_, stateScale_;
+  Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
 };
 
