@@ -17,8 +17,19 @@ class Assembler {
 
   // Zero residual, tangent values and the flows of the evaluation.
   void clear();
+  // Add every component's EEM step residual and tangent.
+  void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
+    add(model, ws, 1.0, [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
+  }
+  // Add every component's rate residual and tangent times `weight` (trapezoidal rule: two
+  // evaluations of weight 1/2).
+  void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
+    add(model, ws, weight, [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
+  }
+
+ private:
   // Evaluate every component with evaluate(component, workspace, local, flows) and add the
-  // result times `weight` (trapezoidal rule: two evaluations of weight 1/2).
+  // result times `weight`.
   template <class Evaluate>
   void add(const Model& model, Workspace& ws, double weight, const Evaluate& evaluate) {
     const auto& components = model.components();
@@ -35,6 +46,8 @@ class Assembler {
     }
   }
 
+
+ public:
   const Eigen::VectorXd& residual() const { return residual_; }
   const Eigen::SparseMatrix<double>& tangent() const { return tangent_; }
   const Flows& flows() const { return flows_; }

@@ -25,27 +25,19 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
 Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
   assembler_.clear();
   if (scheme_ == Scheme::Eem) {
-    const StepArgs args{zOld.data(), zNew.data(), t, dt};
-    assembler_.add(model_, workspace_, 1.0, [&](const Component& c, Workspace& ws, LocalSystem& l, Flows& f) {
-      c.eemLocal(args, ws, l, f);
-    });
+    assembler_.addStep(model_, workspace_, {zOld.data(), zNew.data(), t, dt});
     return assembler_;
   }
   zDot_ = (zNew - zOld) / dt;
-  auto rate = [this](const RateArgs& args, double weight) {
-    assembler_.add(model_, workspace_, weight, [&](const Component& c, Workspace& ws, LocalSystem& l, Flows& f) {
-      c.rateLocal(args, ws, l, f);
-    });
-  };
   // midpoint: F(t + dt/2, (z + z')/2, (z' - z)/dt)
   if (scheme_ == Scheme::Midpoint) {
     zMid_ = 0.5 * (zOld + zNew);
-    rate({zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5, 1.0 / dt}, 1.0);
+    assembler_.addRate(model_, workspace_, {zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5, 1.0 / dt}, 1.0);
     return assembler_;
   }
   // trapezoidal: mean of F at both end points with the same (z' - z)/dt
-  rate({zOld.data(), zDot_.data(), t, 0.0, 1.0 / dt}, 0.5);
-  rate({zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
+  assembler_.addRate(model_, workspace_, {zOld.data(), zDot_.data(), t, 0.0, 1.0 / dt}, 0.5);
+  assembler_.addRate(model_, workspace_, {zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
   return assembler_;
 }
 

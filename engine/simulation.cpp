@@ -2,9 +2,22 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 namespace mpx {
+
+ConservationMonitor::ConservationMonitor(const Measures& initial, RunSummary& summary)
+    : initialEnergy_(initial.energy), previousEntropy_(initial.entropy), summary_(summary) {}
+
+void ConservationMonitor::observe(const StepRecord& r) {
+  const Measures& m = *r.measures;
+  const double balance = m.energy + r.dissipated - r.externalWork - r.boundaryHeat - initialEnergy_;
+  summary_.maxEnergyBalanceError = std::max(summary_.maxEnergyBalanceError, std::abs(balance) / std::abs(initialEnergy_));
+  const double entropyIncrement = m.entropy - previousEntropy_;
+  summary_.minEntropyIncrement =
+      r.step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
+  previousEntropy_ = m.entropy;
+  summary_.steps = r.step;
+}
 
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
                     const ProgressSink& progress) {
@@ -13,9 +26,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
   Eigen::VectorXd state = model.initialState(), next(state.size());
   Measures measures;
   model.measure(state, measures);
-  const double energy0 = measures.energy;
-  double previousEntropy = measures.entropy;
-  summary.minEntropyIncrement = std::numeric_limits<double>::infinity();
+  ConservationMonitor monitor(measures, summary);
 
   StepRecord record;
   record.state = &state;
@@ -49,17 +60,10 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     record.newtonIterations = outcome.iterations;
     record.cutbacks = outcome.cutbacks;
     sink(record);
-
-    const double balance =
-        measures.energy + record.dissipated - record.externalWork - record.boundaryHeat - energy0;
-    summary.maxEnergyBalanceError = std::max(summary.maxEnergyBalanceError, std::abs(balance) / std::abs(energy0));
-    summary.minEntropyIncrement = std::min(summary.minEntropyIncrement, measures.entropy - previousEntropy);
-    previousEntropy = measures.entropy;
-    summary.steps = n;
+    monitor.observe(record);
     if (progress && n % progressEvery == 0) progress(static_cast<double>(n) / steps);
   }
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (summary.steps == 0) summary.minEntropyIncrement = 0.0;
   return summary;
 }
 

@@ -4,6 +4,7 @@
 #include "integrator.hpp"
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace mpx {
@@ -28,6 +29,15 @@ struct StepRecord {
   int cutbacks = 0;
 };
 
+// SUNDIALS IDA's counters for a run (see engine/ida_simulation.hpp).
+struct IdaStatistics {
+  long steps = 0;
+  long residualEvaluations = 0;
+  long jacobianEvaluations = 0;
+  long nonlinearIterations = 0;
+  long errorTestFailures = 0;
+};
+
 struct RunSummary {
   int steps = 0;
   long newtonIterations = 0;
@@ -37,10 +47,23 @@ struct RunSummary {
   // external work W and boundary heat Q (the plain energy drift for an isolated system)
   double maxEnergyBalanceError = 0.0;
   double minEntropyIncrement = 0.0;  // min_n (S_n - S_{n-1})
+  std::optional<IdaStatistics> ida;  // set for IDA runs
   bool failed = false;
   int failedStep = 0;
   double failedTime = 0.0;
   std::string failure;
+};
+
+// Keeps a run summary's conservation figures (energy balance error, entropy increments) up to
+// date as step records arrive; shared by the fixed-step and the IDA loops.
+class ConservationMonitor {
+ public:
+  ConservationMonitor(const Measures& initial, RunSummary& summary);
+  void observe(const StepRecord& record);
+
+ private:
+  double initialEnergy_, previousEntropy_;
+  RunSummary& summary_;
 };
 
 using StepSink = std::function<void(const StepRecord&)>;

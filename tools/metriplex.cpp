@@ -2,6 +2,7 @@
 // Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure.
 #include "history_csv.hpp"
 
+#include "engine/ida_simulation.hpp"
 #include "engine/input_error.hpp"
 #include "models/scene/scene_loader.hpp"
 
@@ -20,17 +21,20 @@ constexpr int kExitInvalidInput = 2;
 constexpr int kExitSolverFailure = 3;
 
 struct IntegratorChoice {
-  Scheme scheme;
+  bool ida;       // SUNDIALS IDA instead of a one-step scheme
+  Scheme scheme;  // the one-step scheme otherwise
   std::optional<ThermalVariable> thermalVariable;  // empty: the scene's own
 };
 
 IntegratorChoice parseIntegrator(const std::string& name) {
-  if (name == "eem") return {Scheme::Eem, std::nullopt};
-  if (name == "eem-entropy") return {Scheme::Eem, ThermalVariable::Entropy};
-  if (name == "eem-temperature") return {Scheme::Eem, ThermalVariable::Temperature};
-  if (name == "midpoint") return {Scheme::Midpoint, std::nullopt};
-  if (name == "trapezoidal") return {Scheme::Trapezoidal, std::nullopt};
-  throw InputError("unknown integrator '" + name + "' (choose eem, eem-entropy, eem-temperature, midpoint, trapezoidal)");
+  if (name == "eem") return {false, Scheme::Eem, std::nullopt};
+  if (name == "eem-entropy") return {false, Scheme::Eem, ThermalVariable::Entropy};
+  if (name == "eem-temperature") return {false, Scheme::Eem, ThermalVariable::Temperature};
+  if (name == "midpoint") return {false, Scheme::Midpoint, std::nullopt};
+  if (name == "trapezoidal") return {false, Scheme::Trapezoidal, std::nullopt};
+  if (name == "ida") return {true, Scheme::Eem, std::nullopt};
+  throw InputError("unknown integrator '" + name +
+                   "' (choose eem, eem-entropy, eem-temperature, midpoint, trapezoidal, ida)");
 }
 
 struct RunRequest {
@@ -38,6 +42,10 @@ struct RunRequest {
   std::string integrator;  // empty: the scene's default
   std::optional<double> dt, tEnd;
   std::string out;  // empty: out/<scene>-<integrator>
+  // IDA only
+  double relativeTolerance = 1e-6, absoluteTolerance = 1e-8;
+  int maxOrder = 5;
+  std::optional<double> outputStep;
 };
 
 struct RunResult {
@@ -46,7 +54,7 @@ struct RunResult {
   std::filesystem::path history;
 };
 
-void checkPositive(const std::optional<double>& value, const char* option) {
+void checkPositive(std::optional<double> value, const char* option) {
   if (value && !(*value > 0.0 && std::isfinite(*value)))
     throw InputError(fmt::format("option {} must be a positive number, got {}", option, *value));
 }
@@ -66,17 +74,19 @@ ProgressSink progressBar(const std::string& label) {
 RunResult runScene(const RunRequest& request) {
   checkPositive(request.dt, "--dt");
   checkPositive(request.tEnd, "--t-end");
+  checkPositive(request.relativeTolerance, "--rtol");
+  checkPositive(request.absoluteTolerance, "--atol");
+  checkPositive(request.outputStep, "--dt-out");
+  if (request.maxOrder < 1 || request.maxOrder > 5)
+    throw InputError(fmt::format("option --max-order must be 1 to 5, got {}", request.maxOrder));
   std::optional<IntegratorChoice> choice;
   if (!request.integrator.empty()) choice = parseIntegrator(request.integrator);
   CompiledScene scene = loadScene(request.scene, choice ? choice->thermalVariable : std::nullopt);
   const std::string integrator = request.integrator.empty() ? scene.settings.integrator : request.integrator;
   if (!choice) choice = parseIntegrator(integrator);
 
-  RunOptions options;
-  options.scheme = choice->scheme;
-  options.dt = request.dt.value_or(scene.settings.dt);
-  options.tEnd = request.tEnd.value_or(scene.settings.tEnd);
-  options.newton = scene.settings.newton;
+  const double dt = request.dt.value_or(scene.settings.dt);
+  const double tEnd = request.tEnd.value_or(scene.settings.tEnd);
 
   const std::filesystem::path out =
       request.out.empty() ? std::filesystem::path("out") / (scene.settings.name + "-" + integrator)
@@ -86,8 +96,15 @@ RunResult runScene(const RunRequest& request) {
   RunResult result{integrator,
                    scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature",
                    {}, history.path()};
-  result.summary = simulate(*scene.model, options, [&](const StepRecord& r) { history.write(r); },
-                            progressBar(scene.settings.name + " " + integrator));
+  const StepSink write = [&](const StepRecord& r) { history.write(r); };
+  const ProgressSink progress = progressBar(scene.settings.name + " " + integrator);
+  if (choice->ida) {
+    const IdaOptions options{request.relativeTolerance, request.absoluteTolerance, request.maxOrder,
+                             request.outputStep.value_or(dt), tEnd};
+    result.summary = simulateIda(*scene.model, options, write, progress);
+  } else {
+    result.summary = simulate(*scene.model, {choice->scheme, dt, tEnd, scene.settings.newton}, write, progress);
+  }
   history.finish(result.summary);
   return result;
 }
@@ -98,7 +115,13 @@ void printSummary(const RunResult& r, const RunRequest& request) {
   fmt::print("  steps                    {}\n", s.steps);
   fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations,
              s.steps ? static_cast<double>(s.newtonIterations) / s.steps : 0.0);
-  fmt::print("  cut-backs                {}\n", s.cutbacks);
+  if (s.ida)
+    fmt::print("  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
+               "{} nonlinear iterations, {} error-test failures\n",
+               s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
+               s.ida->errorTestFailures);
+  else
+    fmt::print("  cut-backs                {}\n", s.cutbacks);
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
   fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / |E0|)\n",
              s.maxEnergyBalanceError);
@@ -162,9 +185,14 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "run one scene with one integrator; writes DIR/history.csv");
   addCommon(run);
   run->add_option("--integrator", request.integrator,
-                  "eem (the scene's thermal variable), eem-entropy, eem-temperature, midpoint, trapezoidal "
+                  "eem (the scene's thermal variable), eem-entropy, eem-temperature, midpoint, trapezoidal, ida "
                   "(default: the scene's simulation integrator)");
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
+  run->add_option("--rtol", request.relativeTolerance, "ida: relative tolerance")->capture_default_str();
+  run->add_option("--atol", request.absoluteTolerance, "ida: absolute tolerance, times each dof's scale")
+      ->capture_default_str();
+  run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
+  run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   CLI::App* compare = app.add_subcommand("compare", "run one scene with several integrators and tabulate "
                                                     "energy drift, entropy and cost side by side");
   addCommon(compare);
