@@ -212,7 +212,8 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
     summary.failedTime = t;
     summary.failure = what + ": " + ida.error();
   };
-  if (!ida.initialise(std::min(options.outputStep, options.tEnd))) fail(0, 0.0, "IDACalcIC failed");
+  // IDACalcIC takes its step scale from the first output time: keep that short
+  if (!ida.initialise(std::min(options.outputStep, 0.01 * options.tEnd))) fail(0, 0.0, "IDACalcIC failed");
   long previousIterations = 0, previousErrorTestFailures = 0;
   for (int k = 1; k <= outputs && !summary.failed; ++k) {
     const double tout = k == outputs ? options.tEnd : k * options.outputStep;

@@ -24,8 +24,13 @@ const char* ElementReader::raw(const char* attribute) {
 
 std::string ElementReader::text(const char* attribute) {
   const char* value = raw(attribute);
-  if (!value) fail(std::string("missing required attribute '") + attribute + "'");
-  return value;
+  if (value) return value;
+  // name what is there, so a misspelt attribute is easy to spot
+  std::string present;
+  for (const tinyxml2::XMLAttribute* a = element_.FirstAttribute(); a; a = a->Next())
+    present += std::string(present.empty() ? "" : ", ") + a->Name();
+  fail(std::string("missing required attribute '") + attribute + "' (attributes given: " +
+       (present.empty() ? "none" : present) + ")");
 }
 
 std::string ElementReader::text(const char* attribute, const std::string& fallback) {

@@ -1,6 +1,7 @@
 #include "scene_loader.hpp"
 
 #include "element_reader.hpp"
+#include "engine/method.hpp"
 #include "models/damper.hpp"
 #include "models/external_force.hpp"
 #include "models/fixed_temperature.hpp"
@@ -94,6 +95,9 @@ CompiledScene SceneCompiler::compile() {
   scale_ = Eigen::VectorXd::Zero(layout_.total());
 
   for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) addElement(*e);
+  if (layout_.total() == 0)
+    throw InputError(file_, root_.GetLineNum(),
+                     "<metriplex>: the scene has nothing to integrate (no mass, thermal element or reservoir)");
 
   // Newton's increment scales: a length for positions, length per run time for velocities
   const double length = positionScale_ > 0.0 ? positionScale_ : 1.0;
@@ -107,11 +111,15 @@ CompiledScene SceneCompiler::compile() {
 }
 
 void SceneCompiler::readSettings() {
+  ElementReader root(root_, file_);
+  settings_.name = root.text("name", "scene");
+  root.finish();
   bool haveSimulation = false;
   for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
     ElementReader in(*e, file_);
     if (tag == "simulation") {
+      if (haveSimulation) in.fail("a scene has one <simulation> element; this is the second");
       haveSimulation = true;
       readSimulation(in);
     } else if (tag == "solver") {
@@ -123,7 +131,6 @@ void SceneCompiler::readSettings() {
   }
   if (!haveSimulation)
     throw InputError(file_, root_.GetLineNum(), "<metriplex>: missing <simulation dt=... t_end=...> element");
-  settings_.name = root_.Attribute("name") ? root_.Attribute("name") : "scene";
   variable_ = thermalOverride_.value_or(settings_.thermalVariable);
 }
 
@@ -131,10 +138,18 @@ void SceneCompiler::readSimulation(ElementReader& in) {
   settings_.dt = in.positive("dt");
   settings_.tEnd = in.positive("t_end");
   settings_.integrator = in.text("integrator", "eem");
+  const std::optional<Method> method = methodByName(settings_.integrator);
+  if (!method) in.fail("unknown integrator '" + settings_.integrator + "' (choose " + kMethodNames + ")");
   const std::string variable = in.text("thermal_variable", "temperature");
   if (variable != "temperature" && variable != "entropy")
     in.fail("thermal_variable must be 'temperature' or 'entropy', got '" + variable + "'");
   settings_.thermalVariable = variable == "entropy" ? ThermalVariable::Entropy : ThermalVariable::Temperature;
+  // an integrator that fixes the thermal variable decides it, unless the scene says otherwise
+  if (method->thermalVariable) {
+    if (in.has("thermal_variable") && *method->thermalVariable != settings_.thermalVariable)
+      in.fail("integrator '" + settings_.integrator + "' contradicts thermal_variable='" + variable + "'");
+    settings_.thermalVariable = *method->thermalVariable;
+  }
   const std::string form = in.text("discrete_gradient", "partitioned");
   if (form != "partitioned" && form != "gonzalez")
     in.fail("discrete_gradient must be 'partitioned' or 'gonzalez', got '" + form + "'");
@@ -333,8 +348,13 @@ void SceneCompiler::addReservoir(ElementReader& in) {
   spec.law = law;
   const double thermalScale = variable_ == ThermalVariable::Temperature ? p.referenceTemperature : p.heatCapacity;
   spec.thermalDof = nextThermalDof(spec.name, thermalScale, spec.thermalNode);
-  state_[spec.thermalDof] = in.has("temperature") ? law->thermalVariableFromTemperature(0.0, in.positive("temperature"), 0.0)
-                                                  : law->thermalVariableFromEntropy(0.0, in.number("entropy"), 0.0);
+  try {
+    state_[spec.thermalDof] = in.has("temperature")
+                                  ? law->thermalVariableFromTemperature(0.0, in.positive("temperature"), 0.0)
+                                  : law->thermalVariableFromEntropy(0.0, in.number("entropy"), 0.0);
+  } catch (const std::invalid_argument& e) {
+    in.fail(e.what());
+  }
   spec.argumentScale = Vec3(1.0, thermalScale, 1.0);
   addLumpedElement(std::move(spec));
 }

@@ -1,0 +1,36 @@
+#pragma once
+// Integration methods by name, and one entry point that runs any of them on a model:
+// EEM (with the scene's or a forced thermal variable), implicit midpoint, trapezoidal, IDA.
+#include "ida_simulation.hpp"
+#include "model.hpp"
+#include "simulation.hpp"
+
+#include <optional>
+#include <string>
+
+namespace mpx {
+
+struct Method {
+  std::string name;
+  bool ida = false;             // SUNDIALS IDA instead of a one-step scheme
+  Scheme scheme = Scheme::Eem;  // the one-step scheme otherwise
+  std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
+};
+
+// The names methodByName accepts, for messages.
+inline constexpr const char* kMethodNames = "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, ida";
+std::optional<Method> methodByName(const std::string& name);
+
+struct MethodParameters {
+  double dt = 0.0;  // step of one-step schemes; IDA's output interval
+  double tEnd = 0.0;
+  NewtonSettings newton;
+  double relativeTolerance = 1e-6;  // IDA
+  double absoluteTolerance = 1e-8;  // IDA, times each dof's scale
+  int maxOrder = 5;                 // IDA
+};
+
+RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters,
+                     const StepSink& sink, const ProgressSink& progress = nullptr);
+
+}  // namespace mpx

@@ -1,0 +1,327 @@
+// End-to-end tests of the metriplex command line: exit codes, error messages that point at the
+// offending file, line, element and attribute, no output directory on invalid input, and
+// DIR/history.csv on success and on a solver failure.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The exit codes tools/metriplex.cpp promises.
+constexpr int kExitSuccess = 0;
+constexpr int kExitInvalidInput = 2;
+constexpr int kExitSolverFailure = 3;
+
+std::string readFile(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream stream(text);
+  for (std::string line; std::getline(stream, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> splitFields(const std::string& row) {
+  std::vector<std::string> fields;
+  std::istringstream stream(row);
+  for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
+  return fields;
+}
+
+// Single quotes keep the shell from splitting or expanding a path.
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+// `text` with its first `from` replaced by `to`: a valid scene with one defect.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  return text.replace(text.find(from), from.size(), to);
+}
+
+// A scene with <simulation> on line 3, an anchor "pivot" on line 4 and `elements` from line 5
+// on, so each bad-input case knows the line its message must name.
+std::string sceneWith(const std::string& elements) {
+  return "<?xml version=\"1.0\"?>\n"
+         "<metriplex name=\"cli\">\n"
+         "  <simulation dt=\"0.125\" t_end=\"1\"/>\n"
+         "  <anchor name=\"pivot\" position=\"0 0 0\"/>\n" +
+         elements + "\n</metriplex>\n";
+}
+
+// A valid, thermal scene: a mass swinging on a thermo-spring with a temperature-dependent,
+// non-linear stiffness (fine for eem, rejected by eem-entropy), heated through a wall.
+const std::string kSwingElements =
+    "  <mass name=\"bob\" mass=\"1\" position=\"1.2 0 0\" velocity=\"0 1 0\"/>\n"
+    "  <thermo_spring name=\"spring\" a=\"pivot\" b=\"bob\" stiffness=\"1\" stiffness_slope=\"-0.2\"\n"
+    "                 stiffness_curvature=\"0.05\" coupling=\"0.5\" rest_length=\"1\" heat_capacity=\"1\"\n"
+    "                 reference_temperature=\"1\" temperature=\"1\"/>\n"
+    "  <fixed_temperature name=\"wall\" temperature=\"2\"/>\n"
+    "  <heat_link name=\"to_wall\" a=\"spring\" b=\"wall\" conductivity=\"0.2\"/>";
+const std::string kSwingScene = sceneWith(kSwingElements);
+constexpr int kSwingSteps = 8;  // t_end / dt
+
+// What one run of the binary did.
+struct Invocation {
+  int exitCode = -1;
+  std::string out, err;
+};
+
+// Each test gets a fresh directory for its scene, its output and the captured streams.
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "metriplex-cli-XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr) << "cannot create a temporary directory";
+    dir_ = pattern;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path writeScene(const std::string& xml) const {
+    const fs::path path = dir_ / "scene.xml";
+    std::ofstream(path) << xml;
+    return path;
+  }
+  fs::path outDir() const { return dir_ / "out"; }
+
+  // Run `metriplex arguments` with stdout and stderr captured to files.
+  Invocation metriplex(const std::string& arguments) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command =
+        quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
+    const int status = std::system(command.c_str());
+    Invocation result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = readFile(out);
+    result.err = readFile(err);
+    return result;
+  }
+
+  fs::path dir_;
+};
+
+// One invalid scene: its text, extra options, the line its message must name and the words
+// (element, attribute, what is wrong) the message must contain.
+struct BadScene {
+  std::string label;
+  std::string xml;
+  std::string options;
+  int line;
+  std::vector<std::string> mentions;
+};
+
+// Test names come from the labels.
+std::ostream& operator<<(std::ostream& os, const BadScene& c) { return os << c.label; }
+
+const std::vector<BadScene> kBadScenes = {
+    {"MalformedXml",
+     "<?xml version=\"1.0\"?>\n<metriplex name=\"cli\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n"
+     "  <mass name=\"bob\" mass=\"1\">\n</metriplex>\n",
+     "", 4, {"malformed XML", "mass"}},
+    {"WrongRoot", "<?xml version=\"1.0\"?>\n<scene name=\"cli\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n</scene>\n",
+     "", 2, {"root element", "<metriplex>", "<scene>"}},
+    {"UnknownElement", sceneWith("  <spring_damper name=\"sd\" a=\"pivot\" b=\"pivot\"/>"), "", 5,
+     {"<spring_damper", "unknown element"}},
+    {"MisspeltAttribute", sceneWith("  <mass name=\"bob\" mass=\"1\" positon=\"1 0 0\"/>"), "", 5,
+     {"<mass name=\"bob\">", "unknown attribute 'positon'"}},
+    {"MisspeltRootAttribute", replaced(kSwingScene, "name=\"cli\"", "nmae=\"cli\""), "", 2,
+     {"<metriplex", "unknown attribute 'nmae'"}},
+    {"MissingRequiredAttribute", sceneWith("  <mass name=\"bob\" position=\"1 0 0\"/>"), "", 5,
+     {"<mass name=\"bob\">", "missing required attribute 'mass'"}},
+    {"NegativeMass", sceneWith("  <mass name=\"bob\" mass=\"-2\" position=\"1 0 0\"/>"), "", 5,
+     {"<mass name=\"bob\">", "'mass' must be positive"}},
+    {"ZeroRestLength",
+     sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>\n"
+               "  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"10\" rest_length=\"0\"/>"),
+     "", 6, {"<spring name=\"s\">", "'rest_length' must be positive"}},
+    {"NegativeHeatCapacity", sceneWith("  <reservoir name=\"env\" heat_capacity=\"-1\" temperature=\"1\"/>"), "", 5,
+     {"<reservoir name=\"env\">", "'heat_capacity' must be positive"}},
+    {"ZeroTemperature", sceneWith("  <fixed_temperature name=\"wall\" temperature=\"0\"/>"), "", 5,
+     {"<fixed_temperature name=\"wall\">", "'temperature' must be positive"}},
+    {"NanValue", sceneWith("  <mass name=\"bob\" mass=\"nan\" position=\"1 0 0\"/>"), "", 5,
+     {"<mass name=\"bob\">", "'mass' must be finite"}},
+    {"InfValue", sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 inf 0\"/>"), "", 5,
+     {"<mass name=\"bob\">", "'position' must be finite"}},
+    {"NonNumericValue",
+     sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>\n"
+               "  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"stiff\" rest_length=\"1\"/>"),
+     "", 6, {"<spring name=\"s\">", "'stiffness'", "'stiff' is not a number"}},
+    {"VectorWithTwoNumbers", sceneWith("  <mass name=\"bob\" mass=\"1\" velocity=\"0 1\"/>"), "", 5,
+     {"<mass name=\"bob\">", "'velocity' needs 3 numbers, got 2"}},
+    {"DuplicateName", sceneWith("  <mass name=\"pivot\" mass=\"1\" position=\"1 0 0\"/>"), "", 5,
+     {"<mass name=\"pivot\">", "'pivot' is already used on line 4"}},
+    {"UndeclaredMass",
+     sceneWith("  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"10\" rest_length=\"1\"/>\n"
+               "  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>"),
+     "", 5, {"<spring name=\"s\">", "'b'", "no mass or anchor named 'bob'"}},
+    {"HeatLinkToNonThermalNode",
+     sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" temperature=\"1\"/>\n"
+               "  <heat_link name=\"h\" a=\"env\" b=\"pivot\" conductivity=\"1\"/>"),
+     "", 6, {"<heat_link name=\"h\">", "'b'", "no thermal node named 'pivot'"}},
+    {"EntropyFormWithCurvedStiffness", kSwingScene, "--integrator eem-entropy", 6,
+     {"<thermo_spring name=\"spring\">", "stiffness_curvature"}},
+    {"SceneEntropyIntegratorWithCurvedStiffness",
+     replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"eem-entropy\""), "", 6,
+     {"<thermo_spring name=\"spring\">", "stiffness_curvature"}},
+    {"MissingSimulation", "<?xml version=\"1.0\"?>\n<metriplex name=\"cli\">\n  <anchor name=\"pivot\"/>\n</metriplex>\n",
+     "", 2, {"missing <simulation"}},
+    {"DuplicateSimulation", sceneWith("  <simulation dt=\"0.5\" t_end=\"1\"/>\n" + kSwingElements), "", 5,
+     {"<simulation"}},
+    {"UnknownSceneIntegrator", replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"rk4\""), "", 3,
+     {"<simulation>", "integrator", "'rk4'"}},
+    {"NothingToSimulate", sceneWith(""), "", 2, {"<metriplex"}},
+    {"ReservoirEntropyOverflowingTemperature",
+     sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" entropy=\"1000\"/>"), "", 5,
+     {"<reservoir name=\"env\">", "entropy"}},
+};
+
+class BadSceneTest : public CliTest, public ::testing::WithParamInterface<BadScene> {};
+
+// exit 2, "file:line:" plus the element and what is wrong, and no output directory
+TEST_P(BadSceneTest, ExitsTwoWithFileLineAndCauseAndWritesNothing) {
+  const BadScene& c = GetParam();
+  const fs::path scene = writeScene(c.xml);
+  const Invocation r = metriplex("run " + quoted(scene) + " " + c.options + " --out " + quoted(outDir()));
+  EXPECT_EQ(r.exitCode, kExitInvalidInput) << r.err;
+  EXPECT_NE(r.err.find(scene.string() + ":" + std::to_string(c.line) + ":"), std::string::npos) << r.err;
+  for (const std::string& mention : c.mentions) EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(outDir()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, BadSceneTest, ::testing::ValuesIn(kBadScenes),
+                         [](const ::testing::TestParamInfo<BadScene>& info) { return info.param.label; });
+
+// A missing file has no line: the message names the path.
+TEST_F(CliTest, MissingSceneFileExitsTwoAndWritesNothing) {
+  const fs::path scene = dir_ / "no_such_scene.xml";
+  const Invocation r = metriplex("run " + quoted(scene) + " --out " + quoted(outDir()));
+  EXPECT_EQ(r.exitCode, kExitInvalidInput);
+  EXPECT_NE(r.err.find(scene.string() + ": cannot open"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(outDir()));
+}
+
+// One invalid command line on the valid swing scene and the words its message must contain.
+struct BadOptions {
+  std::string label;
+  std::string command;  // "run SCENE --out DIR" or "compare SCENE --out DIR", then options
+  std::string options;
+  std::vector<std::string> mentions;
+};
+
+std::ostream& operator<<(std::ostream& os, const BadOptions& c) { return os << c.label; }
+
+const std::vector<BadOptions> kBadOptions = {
+    {"UnknownIntegrator", "run", "--integrator rk4", {"unknown integrator 'rk4'"}},
+    {"NegativeStep", "run", "--dt -0.1", {"--dt", "positive"}},
+    {"ZeroEndTime", "run", "--t-end 0", {"--t-end", "positive"}},
+    {"UnknownOption", "run", "--frobnicate", {"--frobnicate"}},
+    {"CompareUnknownIntegrator", "compare", "--integrators eem,rk4", {"unknown integrator 'rk4'"}},
+    // the second integrator cannot take this scene: nothing may be run before that is known
+    {"CompareIntegratorTheSceneRejects", "compare", "--integrators eem,eem-entropy", {"stiffness_curvature"}},
+};
+
+class BadOptionsTest : public CliTest, public ::testing::WithParamInterface<BadOptions> {};
+
+TEST_P(BadOptionsTest, ExitsTwoWithCauseAndWritesNothing) {
+  const BadOptions& c = GetParam();
+  const fs::path scene = writeScene(kSwingScene);
+  const Invocation r = metriplex(c.command + " " + quoted(scene) + " --out " + quoted(outDir()) + " " + c.options);
+  EXPECT_EQ(r.exitCode, kExitInvalidInput) << r.err;
+  for (const std::string& mention : c.mentions) EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(outDir()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, BadOptionsTest, ::testing::ValuesIn(kBadOptions),
+                         [](const ::testing::TestParamInfo<BadOptions>& info) { return info.param.label; });
+
+// The header names the conserved and exchanged quantities; every row is complete.
+void expectCompleteHistory(const std::vector<std::string>& lines, std::size_t rows) {
+  ASSERT_EQ(lines.size(), rows + 1);
+  const std::vector<std::string> header = splitFields(lines.front());
+  for (const char* column : {"time", "energy", "entropy", "dissipated_energy", "external_work", "boundary_heat",
+                             "momentum_x", "momentum_y", "momentum_z", "angular_momentum_x", "angular_momentum_y",
+                             "angular_momentum_z", "newton_iterations", "cutbacks", "constraint_violation",
+                             "temperature_spring", "temperature_wall"})
+    EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(splitFields(lines[i]).size(), header.size()) << lines[i];
+}
+
+// one row per step plus the initial state, from t = 0 to t_end, and no .part file left
+TEST_F(CliTest, RunWritesOneHistoryRowPerStepPlusOne) {
+  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) + " --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "history.csv"));
+  ASSERT_NO_FATAL_FAILURE(expectCompleteHistory(lines, kSwingSteps + 1));
+  EXPECT_EQ(std::stod(splitFields(lines[1]).front()), 0.0);
+  EXPECT_EQ(std::stod(splitFields(lines.back()).front()), 1.0);
+  EXPECT_FALSE(fs::exists(outDir() / "history.csv.part"));
+}
+
+// --dt and --t-end replace the scene's step and end time
+TEST_F(CliTest, StepAndEndTimeOptionsOverrideTheScene) {
+  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) + " --integrator midpoint --dt 0.25 "
+                                 "--t-end 0.5 --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "history.csv"));
+  ASSERT_NO_FATAL_FAILURE(expectCompleteHistory(lines, 3));
+  EXPECT_EQ(std::stod(splitFields(lines.back()).front()), 0.5);
+}
+
+// Newton is allowed one iteration and no cut-back, so the first step that moves (the force
+// ramps up from t = 0.5) cannot converge; the resting steps before it can.
+TEST_F(CliTest, SolverFailureExitsThreeAndKeepsTheGoodSteps) {
+  const std::string scene = sceneWith(
+      "  <solver max_iterations=\"1\" max_cutbacks=\"0\"/>\n"
+      "  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>\n"
+      "  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"1e6\" rest_length=\"1\"/>\n"
+      "  <force name=\"kick\" on=\"bob\" force=\"0 1000 0\" profile=\"ramp\" start=\"0.5\" end=\"0.625\"/>");
+  const Invocation r =
+      metriplex("run " + quoted(writeScene(scene)) + " --integrator midpoint --out " + quoted(outDir()));
+  EXPECT_EQ(r.exitCode, kExitSolverFailure) << r.err;
+  EXPECT_NE(r.err.find("step 5 (t = 0.5)"), std::string::npos) << r.err;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "history.csv"));
+  ASSERT_EQ(lines.size(), 1 + 5 + 1);  // header, t = 0, 0.125, ..., 0.5, failure line
+  EXPECT_EQ(std::stod(splitFields(lines[5]).front()), 0.5);
+  EXPECT_EQ(lines.back().rfind("# solver failure", 0), 0u) << lines.back();
+}
+
+// Both default integrators run, each into its own directory, and the table reports them ok.
+TEST_F(CliTest, CompareRunsEemAndMidpoint) {
+  const Invocation r = metriplex("compare " + quoted(writeScene(kSwingScene)) + " --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  for (const std::string integrator : {"eem", "midpoint"}) {
+    expectCompleteHistory(splitLines(readFile(outDir() / integrator / "history.csv")), kSwingSteps + 1);
+    bool reportedOk = false;
+    for (const std::string& line : splitLines(r.out))
+      reportedOk |= line.rfind(integrator + " ", 0) == 0 && line.size() >= 2 && line.substr(line.size() - 2) == "ok";
+    EXPECT_TRUE(reportedOk) << r.out;
+  }
+}
+
+// Each help text exits 0 and lists what it documents.
+TEST_F(CliTest, HelpExitsZeroAndListsTheOptions) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> helps = {
+      {"--help", {"run", "compare", "Exit codes"}},
+      {"run --help", {"SCENE", "--integrator", "--dt", "--t-end", "--out"}},
+      {"compare --help", {"SCENE", "--integrators", "--dt", "--t-end", "--out"}},
+  };
+  for (const auto& [arguments, mentions] : helps) {
+    const Invocation r = metriplex(arguments);
+    EXPECT_EQ(r.exitCode, kExitSuccess) << arguments;
+    for (const std::string& mention : mentions) EXPECT_NE(r.out.find(mention), std::string::npos) << arguments;
+  }
+}
+
+}  // namespace

@@ -1,0 +1,241 @@
+// metriplex bench: a work-precision sweep of one scene. One-step schemes over a list of steps,
+// IDA over a list of tolerances, each against one cached reference solution (IDA at rtol 1e-12).
+#include "commands.hpp"
+#include "plots.hpp"
+
+#include "engine/input_error.hpp"
+#include "engine/method.hpp"
+#include "models/scene/scene_loader.hpp"
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace mpx {
+
+namespace {
+
+constexpr double kReferenceTolerance = 1e-12;
+// A run whose energy balance is off by more than this (relative) has blown up.
+constexpr double kBlowUpEnergyError = 0.5;
+
+// What is compared with the reference at the final time.
+struct FinalState {
+  Eigen::VectorXd positions;
+  std::vector<double> temperatures;
+};
+
+struct BenchRun {
+  std::string integrator;
+  double dt = 0.0, rtol = 0.0;  // one of the two is the sweep parameter
+  double cpuSeconds = 0.0;
+  RunSummary summary;
+  FinalState final;
+  int entropyViolations = 0;
+  double error = 0.0;
+  std::string status;
+  std::vector<SeriesPoint> series;
+};
+
+FinalState finalStateOf(const Model& model, const Eigen::VectorXd& state, const Measures& measures) {
+  return {state.segment(model.layout().offset(Block::Position), model.layout().size(Block::Position)),
+          measures.nodeTemperature};
+}
+
+// max of the relative position and temperature errors against the reference
+double relativeError(const FinalState& run, const FinalState& reference) {
+  double error = (run.positions - reference.positions).lpNorm<Eigen::Infinity>() /
+                 std::max(reference.positions.lpNorm<Eigen::Infinity>(), 1e-300);
+  double largest = 0.0, deviation = 0.0;
+  for (std::size_t i = 0; i < reference.temperatures.size(); ++i) {
+    largest = std::max(largest, std::abs(reference.temperatures[i]));
+    deviation = std::max(deviation, std::abs(run.temperatures[i] - reference.temperatures[i]));
+  }
+  if (largest > 0.0) error = std::max(error, deviation / largest);
+  return std::isfinite(error) ? error : INFINITY;
+}
+
+// One run, repeated for a median CPU time; keeps the last repeat's results.
+BenchRun measure(const Model& model, const Method& method, const MethodParameters& parameters, int repeats,
+                 bool keepSeries) {
+  BenchRun run;
+  run.integrator = method.name;
+  std::vector<double> cpu;
+  for (int r = 0; r < repeats; ++r) {
+    Measures last;
+    Eigen::VectorXd lastState;
+    double initialEnergy = 0.0, initialEntropy = 0.0, previousEntropy = 0.0;
+    run.entropyViolations = 0;
+    run.series.clear();
+    const std::clock_t start = std::clock();
+    run.summary = runMethod(model, method, parameters, [&](const StepRecord& record) {
+      const Measures& m = *record.measures;
+      if (record.step == 0) initialEnergy = m.energy, initialEntropy = previousEntropy = m.entropy;
+      if (m.entropy < previousEntropy - 1e-14 * std::abs(m.entropy)) ++run.entropyViolations;
+      previousEntropy = m.entropy;
+      if (keepSeries) {
+        const double balance = m.energy + record.dissipated - record.externalWork - record.boundaryHeat - initialEnergy;
+        run.series.push_back({record.time, std::abs(balance / initialEnergy), m.entropy - initialEntropy});
+      }
+      last = m;
+      lastState = *record.state;
+    });
+    cpu.push_back(static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC);
+    run.final = finalStateOf(model, lastState, last);
+  }
+  std::sort(cpu.begin(), cpu.end());
+  run.cpuSeconds = cpu[cpu.size() / 2];
+  return run;
+}
+
+// Reference final state: computed once per scene text and end time, cached in DIR/reference.csv.
+FinalState reference(const Model& model, const std::string& sceneText, double tEnd, const std::filesystem::path& dir) {
+  const std::string key = fmt::format("ida rtol {:g} t_end {:.17g} scene {}", kReferenceTolerance, tEnd,
+                                      std::hash<std::string>{}(sceneText));
+  const std::filesystem::path file = dir / "reference.csv";
+  FinalState cached;
+  std::ifstream in(file);
+  std::string line;
+  if (std::getline(in, line) && line == "# " + key) {
+    std::vector<double> values;
+    for (double v; in >> v;) {
+      values.push_back(v);
+      if (in.peek() == ',') in.ignore();
+    }
+    const Eigen::Index positions = model.layout().size(Block::Position);
+    if (values.size() == positions + model.thermalNodeNames().size()) {
+      cached.positions = Eigen::Map<Eigen::VectorXd>(values.data(), positions);
+      cached.temperatures.assign(values.begin() + positions, values.end());
+      fmt::print("reference: cached in {}\n", file.string());
+      return cached;
+    }
+  }
+  MethodParameters parameters;
+  parameters.dt = tEnd / 100;
+  parameters.tEnd = tEnd;
+  parameters.relativeTolerance = kReferenceTolerance;
+  parameters.absoluteTolerance = kReferenceTolerance;
+  const BenchRun run = measure(model, *methodByName("ida"), parameters, 1, false);
+  if (run.summary.failed) throw std::runtime_error("the reference run (IDA, rtol 1e-12) failed: " + run.summary.failure);
+  auto out = fmt::output_file(file.string());
+  out.print("# {}\n", key);
+  std::string row;
+  for (double v : run.final.positions) row += fmt::format("{}{:.17g}", row.empty() ? "" : ",", v);
+  for (double v : run.final.temperatures) row += fmt::format(",{:.17g}", v);
+  out.print("{}\n", row);
+  fmt::print("reference: IDA at rtol {:g} ({:.2f} s CPU), written to {}\n", kReferenceTolerance, run.cpuSeconds,
+             file.string());
+  return run.final;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the scene file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void writeCsv(const std::filesystem::path& file, const std::vector<BenchRun>& runs) {
+  auto out = fmt::output_file(file.string());
+  out.print(
+      "integrator,dt,rtol,cpu_seconds,steps,newton_iterations,ida_steps,ida_residual_evaluations,"
+      "ida_jacobian_evaluations,ida_nonlinear_iterations,ida_error_test_failures,error,energy_drift,"
+      "entropy_violations,status\n");
+  for (const BenchRun& r : runs) {
+    const IdaStatistics ida = r.summary.ida.value_or(IdaStatistics{});
+    out.print("{},{:g},{:g},{:.6g},{},{},{},{},{},{},{},{:.6e},{:.6e},{},{}\n", r.integrator, r.dt, r.rtol,
+              r.cpuSeconds, r.summary.steps, r.summary.newtonIterations, ida.steps, ida.residualEvaluations,
+              ida.jacobianEvaluations, ida.nonlinearIterations, ida.errorTestFailures, r.error,
+              r.summary.maxEnergyBalanceError, r.entropyViolations, r.status);
+  }
+}
+
+}  // namespace
+
+int benchCommand(const BenchRequest& request) {
+  // validate everything before anything is written
+  if (request.repeats < 1) throw InputError("option --repeats must be at least 1");
+  for (double v : request.steps)
+    if (!(v > 0.0 && std::isfinite(v))) throw InputError(fmt::format("option --dts: steps must be positive, got {}", v));
+  for (double v : request.tolerances)
+    if (!(v > 0.0 && v < 1.0)) throw InputError(fmt::format("option --rtols: tolerances must be in (0, 1), got {}", v));
+  if (request.tEnd && !(*request.tEnd > 0.0)) throw InputError("option --t-end must be positive");
+  std::vector<Method> methods;
+  for (const std::string& name : request.integrators) {
+    const std::optional<Method> method = methodByName(name);
+    if (!method) throw InputError(fmt::format("unknown integrator '{}' (choose {})", name, kMethodNames));
+    methods.push_back(*method);
+  }
+  const std::string sceneText = readFile(request.scene);
+  std::map<std::string, CompiledScene> scenes;  // per method name: its thermal variable
+  for (const Method& method : methods)
+    scenes.emplace(method.name, loadSceneText(sceneText, request.scene, method.thermalVariable));
+  const CompiledScene own = loadSceneText(sceneText, request.scene);
+  const SceneSettings& settings = own.settings;
+  const double tEnd = request.tEnd.value_or(settings.tEnd);
+  std::vector<double> steps = request.steps;
+  if (steps.empty())
+    for (double factor : {2.0, 1.0, 0.5, 0.25, 0.125, 0.0625}) steps.push_back(factor * settings.dt);
+  std::vector<double> tolerances = request.tolerances;
+  if (tolerances.empty()) tolerances = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
+  const std::filesystem::path out =
+      request.out.empty() ? std::filesystem::path("out") / (settings.name + "-bench") : std::filesystem::path(request.out);
+
+  std::filesystem::create_directories(out);
+  const FinalState referenceState = reference(*own.model, sceneText, tEnd, out);
+
+  // representative runs for the time series: the scene's step, rtol 1e-6 (or the middle ones)
+  const double seriesStep = std::count(steps.begin(), steps.end(), settings.dt) ? settings.dt : steps[steps.size() / 2];
+  const double seriesTolerance = std::count(tolerances.begin(), tolerances.end(), 1e-6) ? 1e-6 : tolerances[tolerances.size() / 2];
+  std::vector<BenchRun> runs;
+  for (const Method& method : methods) {
+    const Model& model = *scenes.at(method.name).model;
+    for (double value : method.ida ? tolerances : steps) {
+      MethodParameters parameters;
+      parameters.tEnd = tEnd;
+      parameters.newton = settings.newton;
+      parameters.dt = method.ida ? tEnd / 100 : value;
+      parameters.relativeTolerance = value;
+      parameters.absoluteTolerance = 1e-2 * value;
+      const bool keepSeries = value == (method.ida ? seriesTolerance : seriesStep);
+      BenchRun run = measure(model, method, parameters, request.repeats, keepSeries);
+      (method.ida ? run.rtol : run.dt) = value;
+      run.error = run.summary.failed ? INFINITY : relativeError(run.final, referenceState);
+      run.status = run.summary.failed ? "failed"
+                   : !(run.summary.maxEnergyBalanceError < kBlowUpEnergyError) || !(run.error < 1.0) ? "blew-up"
+                                                                                                       : "ok";
+      fmt::print("{:<16} {:>10} {:>10.4g} s CPU  error {:.3e}  energy drift {:.3e}  {}\n", method.name,
+                 fmt::format(method.ida ? "rtol {:g}" : "dt {:g}", value), run.cpuSeconds, run.error,
+                 run.summary.maxEnergyBalanceError, run.status);
+      runs.push_back(std::move(run));
+    }
+  }
+  writeCsv(out / "work_precision.csv", runs);
+
+  // plots: work-precision of the ok runs, energy error and entropy of the representative ones
+  std::vector<WorkPrecisionCurve> workPrecision;
+  std::vector<TimeSeries> series;
+  for (const Method& method : methods) {
+    WorkPrecisionCurve curve{method.name, {}};
+    for (const BenchRun& r : runs)
+      if (r.integrator == method.name && r.status == "ok") curve.cpuAndError.emplace_back(r.cpuSeconds, r.error);
+    workPrecision.push_back(std::move(curve));
+    for (const BenchRun& r : runs)
+      if (r.integrator == method.name && !r.series.empty())
+        series.push_back({fmt::format(method.ida ? "{} rtol {:g}" : "{} dt {:g}", method.name, method.ida ? r.rtol : r.dt),
+                          r.series});
+  }
+  renderPlots(out, settings.name, tEnd, workPrecision, series);
+  fmt::print("wrote {}/work_precision.csv, work_precision.png, energy_error.png, entropy.png\n", out.string());
+  return 0;
+}
+
+}  // namespace mpx

@@ -1,0 +1,154 @@
+// metriplex run and metriplex compare.
+#include "commands.hpp"
+#include "history_csv.hpp"
+
+#include "engine/input_error.hpp"
+#include "engine/method.hpp"
+#include "models/scene/scene_loader.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace mpx {
+
+namespace {
+
+// A run whose input has been fully validated: nothing is written before this exists.
+struct PreparedRun {
+  Method method;
+  CompiledScene scene;
+  MethodParameters parameters;
+  std::filesystem::path out;
+};
+
+struct RunResult {
+  std::string variable;
+  RunSummary summary;
+  std::filesystem::path history;
+};
+
+void checkPositive(std::optional<double> value, const char* option) {
+  if (value && !(*value > 0.0 && std::isfinite(*value)))
+    throw InputError(fmt::format("option {} must be a positive number, got {}", option, *value));
+}
+
+Method methodOrThrow(const std::string& name) {
+  const std::optional<Method> method = methodByName(name);
+  if (!method) throw InputError(fmt::format("unknown integrator '{}' (choose {})", name, kMethodNames));
+  return *method;
+}
+
+// Draws a progress bar on a terminal; silent when stderr is redirected.
+ProgressSink progressBar(const std::string& label) {
+  if (!isatty(fileno(stderr))) return nullptr;
+  return [label](double fraction) {
+    const int width = 40, done = static_cast<int>(fraction * width);
+    fmt::print(stderr, "\r{} [{}{}] {:3.0f}%", label, std::string(done, '#'), std::string(width - done, ' '),
+               100 * fraction);
+    if (fraction >= 1.0) fmt::print(stderr, "\n");
+  };
+}
+
+PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
+  checkPositive(request.dt, "--dt");
+  checkPositive(request.tEnd, "--t-end");
+  checkPositive(request.relativeTolerance, "--rtol");
+  checkPositive(request.absoluteTolerance, "--atol");
+  checkPositive(request.outputStep, "--dt-out");
+  if (request.maxOrder < 1 || request.maxOrder > 5)
+    throw InputError(fmt::format("option --max-order must be 1 to 5, got {}", request.maxOrder));
+  std::optional<Method> method;
+  if (!request.integrator.empty()) method = methodOrThrow(request.integrator);
+  CompiledScene scene = loadScene(request.scene, method ? method->thermalVariable : std::nullopt);
+  if (!method) method = methodOrThrow(scene.settings.integrator);
+
+  MethodParameters parameters;
+  parameters.dt = request.dt.value_or(scene.settings.dt);
+  parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
+  parameters.newton = scene.settings.newton;
+  parameters.relativeTolerance = request.relativeTolerance;
+  parameters.absoluteTolerance = request.absoluteTolerance;
+  parameters.maxOrder = request.maxOrder;
+  if (method->ida) parameters.dt = request.outputStep.value_or(parameters.dt);
+  std::filesystem::path out = request.out.empty()
+                                  ? std::filesystem::path("out") / (scene.settings.name + "-" + outSuffix)
+                                  : std::filesystem::path(request.out);
+  return {*method, std::move(scene), parameters, std::move(out)};
+}
+
+RunResult execute(const PreparedRun& run) {
+  std::filesystem::create_directories(run.out);
+  HistoryCsv history(run.out, *run.scene.model);
+  RunResult result{run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {},
+                   history.path()};
+  result.summary = runMethod(*run.scene.model, run.method, run.parameters,
+                             [&](const StepRecord& r) { history.write(r); },
+                             progressBar(run.scene.settings.name + " " + run.method.name));
+  history.finish(result.summary);
+  return result;
+}
+
+double perStep(long count, int steps) { return steps ? static_cast<double>(count) / steps : 0.0; }
+
+void printSummary(const RunResult& r, const RunRequest& request, const Method& method) {
+  const RunSummary& s = r.summary;
+  fmt::print("metriplex run {} --integrator {} (thermal variable: {})\n", request.scene, method.name, r.variable);
+  fmt::print("  steps                    {}{}\n", s.steps, s.ida ? " (output times)" : "");
+  fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations, perStep(s.newtonIterations, s.steps));
+  if (s.ida)
+    fmt::print("  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
+               "{} nonlinear iterations, {} error-test failures\n",
+               s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
+               s.ida->errorTestFailures);
+  else
+    fmt::print("  cut-backs                {}\n", s.cutbacks);
+  fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
+  fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / |E0|)\n",
+             s.maxEnergyBalanceError);
+  fmt::print("  min entropy increment    {:.3e}\n", s.minEntropyIncrement);
+  fmt::print("  history                  {}\n", r.history.string());
+}
+
+}  // namespace
+
+int runCommand(const RunRequest& request) {
+  const PreparedRun run = prepare(request, request.integrator.empty() ? "run" : request.integrator);
+  const RunResult result = execute(run);
+  printSummary(result, request, run.method);
+  if (!result.summary.failed) return 0;
+  fmt::print(stderr, "metriplex: solver failure at step {} (t = {:.9g}): {}; history kept up to the last good step in {}\n",
+             result.summary.failedStep, result.summary.failedTime, result.summary.failure, result.history.string());
+  return kExitSolverFailure;
+}
+
+int compareCommand(const RunRequest& base, const std::vector<std::string>& integrators) {
+  // validate every run before the first one writes anything
+  std::vector<PreparedRun> runs;
+  for (const std::string& name : integrators) {
+    RunRequest request = base;
+    request.integrator = name;
+    request.out.clear();
+    runs.push_back(prepare(request, "compare"));
+  }
+  const std::filesystem::path root = base.out.empty() ? runs.front().out : std::filesystem::path(base.out);
+  fmt::print("{:<16} {:>8} {:>12} {:>10} {:>16} {:>16}  {}\n", "integrator", "steps", "newton/step", "wall [s]",
+             "max energy drift", "min dS per step", "status");
+  // a blow-up is a finding here, not an error
+  for (PreparedRun& run : runs) {
+    run.out = root / run.method.name;
+    const RunResult r = execute(run);
+    const RunSummary& s = r.summary;
+    const std::string status =
+        s.failed ? fmt::format("failed at step {} (t = {:.6g}): {}", s.failedStep, s.failedTime, s.failure) : "ok";
+    fmt::print("{:<16} {:>8} {:>12.2f} {:>10.3f} {:>16.3e} {:>16.3e}  {}\n", run.method.name, s.steps,
+               perStep(s.newtonIterations, s.steps), s.wallSeconds, s.maxEnergyBalanceError, s.minEntropyIncrement,
+               status);
+  }
+  fmt::print("histories in {}/<integrator>/history.csv\n", root.string());
+  return 0;
+}
+
+}  // namespace mpx

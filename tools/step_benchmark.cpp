@@ -1,0 +1,116 @@
+// metriplex_step_benchmark: cost of one integrator step along a real trajectory (time, Newton
+// iterations, cut-backs) for the benchmark scenes and a generated chain of thermo-springs.
+// Reproduce and read the figures with docs/performance.md.
+#include "models/scene/scene_loader.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+
+namespace {
+
+using namespace mpx;
+
+// A scene compiled in a chosen thermal variable (empty: the scene's own).
+using SceneSource = std::function<CompiledScene(std::optional<ThermalVariable>)>;
+
+// The scenes shipped in scenes/ are read from the source tree.
+SceneSource sceneFile(const std::string& file) {
+  return [file](std::optional<ThermalVariable> variable) {
+    return loadScene(std::string(METRIPLEX_SCENES_DIR) + "/" + file, variable);
+  };
+}
+
+// A chain fixed to an anchor at the origin: masses along x at spacing 1.1 (springs pre-
+// stretched by 0.1) with a transverse velocity pattern, a thermo-spring between consecutive
+// points, temperatures varying along the chain and heat links between neighbouring springs.
+std::string thermoSpringChainXml(int masses, double dt) {
+  std::ostringstream xml;
+  xml << "<metriplex name=\"thermo_spring_chain\">\n"
+      << "  <simulation dt=\"" << dt << "\" t_end=\"100\" thermal_variable=\"entropy\"/>\n"
+      << "  <anchor name=\"origin\" position=\"0 0 0\"/>\n";
+  const auto point = [](int i) { return i == 0 ? std::string("origin") : "m" + std::to_string(i); };
+  for (int i = 1; i <= masses; ++i) {
+    xml << "  <mass name=\"" << point(i) << "\" mass=\"1\" position=\"" << 1.1 * i << " 0 0\" velocity=\"0 "
+        << 0.2 * std::sin(0.3 * i) << ' ' << 0.1 * std::cos(0.7 * i) << "\"/>\n"
+        << "  <thermo_spring name=\"s" << i << "\" a=\"" << point(i - 1) << "\" b=\"" << point(i)
+        << "\" stiffness=\"1\" coupling=\"1\" rest_length=\"1\" heat_capacity=\"1\""
+        << " reference_temperature=\"1\" temperature=\"" << 1.0 + 0.5 * std::sin(i) << "\"/>\n";
+    if (i > 1) xml << "  <heat_link name=\"h" << i << "\" a=\"s" << i - 1 << "\" b=\"s" << i << "\" conductivity=\"1\"/>\n";
+  }
+  xml << "</metriplex>\n";
+  return xml.str();
+}
+
+// Time per step of `scheme` at the scene's dt, stepping on from the previous state so every
+// iteration is a step of one trajectory; the integrator and both states exist before timing.
+void stepBenchmark(benchmark::State& state, const std::shared_ptr<const CompiledScene>& scene, Scheme scheme) {
+  const Model& model = *scene->model;
+  const double dt = scene->settings.dt;
+  Integrator integrator(model, scheme, scene->settings.newton);
+  Eigen::VectorXd z = model.initialState(), zNext(z.size());
+  double t = 0.0;
+  long newtonIterations = 0, cutbacks = 0;
+  for (auto _ : state) {
+    const StepOutcome outcome = integrator.advance(z, t, dt, zNext);
+    if (!outcome.converged) {
+      state.SkipWithError(("step failed at t = " + std::to_string(t) + ": " + outcome.failure).c_str());
+      break;
+    }
+    newtonIterations += outcome.iterations;
+    cutbacks += outcome.cutbacks;
+    z.swap(zNext);
+    t += dt;
+  }
+  state.counters["newton_per_step"] = benchmark::Counter(newtonIterations, benchmark::Counter::kAvgIterations);
+  state.counters["cutbacks_per_step"] = benchmark::Counter(cutbacks, benchmark::Counter::kAvgIterations);
+  state.counters["dofs"] = model.layout().total();
+  state.counters["t_reached"] = t;
+}
+
+struct SchemeChoice {
+  const char* name;
+  Scheme scheme;
+  std::optional<ThermalVariable> variable;
+};
+
+const SchemeChoice kEemEntropy{"eem-entropy", Scheme::Eem, ThermalVariable::Entropy};
+const SchemeChoice kEemTemperature{"eem-temperature", Scheme::Eem, ThermalVariable::Temperature};
+const SchemeChoice kMidpoint{"midpoint", Scheme::Midpoint, std::nullopt};
+const SchemeChoice kTrapezoidal{"trapezoidal", Scheme::Trapezoidal, std::nullopt};
+
+// Compile the scene once per case (outside any timing) and register its step benchmark.
+void registerCases(const std::string& sceneName, const SceneSource& source, std::initializer_list<SchemeChoice> choices) {
+  for (const SchemeChoice& choice : choices) {
+    auto scene = std::make_shared<const CompiledScene>(source(choice.variable));
+    benchmark::RegisterBenchmark((sceneName + "/" + choice.name).c_str(), stepBenchmark, scene, choice.scheme)
+        ->Unit(benchmark::kMicrosecond);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+
+  registerCases("two_thermo_springs", sceneFile("two_thermo_springs.xml"),
+                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
+  registerCases("thermo_visco_elastic", sceneFile("thermo_visco_elastic.xml"),
+                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
+  const std::string chain = thermoSpringChainXml(1000, 0.05);
+  registerCases("thermo_spring_chain_1000",
+                [&chain](std::optional<ThermalVariable> variable) {
+                  return loadSceneText(chain, "thermo_spring_chain", variable);
+                },
+                {kEemEntropy, kEemTemperature, kMidpoint});
+
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
