@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -230,6 +231,12 @@ const std::vector<BadOptions> kBadOptions = {
     {"CompareUnknownIntegrator", "compare", "--integrators eem,rk4", {"unknown integrator 'rk4'"}},
     // the second integrator cannot take this scene: nothing may be run before that is known
     {"CompareIntegratorTheSceneRejects", "compare", "--integrators eem,eem-entropy", {"stiffness_curvature"}},
+    {"NegativeRelativeTolerance", "run", "--integrator ida --rtol -1e-6", {"--rtol", "positive"}},
+    {"MaxOrderSix", "run", "--integrator ida --max-order 6", {"--max-order", "1 to 5"}},
+    {"BenchUnknownIntegrator", "bench", "--integrators eem,rk4", {"unknown integrator 'rk4'"}},
+    {"BenchNegativeTolerance", "bench", "--rtols 1e-3,-1e-6", {"--rtols", "-1e-06"}},
+    {"BenchZeroStep", "bench", "--dts 0.1,0", {"--dts", "positive"}},
+    {"BenchZeroRepeats", "bench", "--repeats 0", {"--repeats"}},
 };
 
 class BadOptionsTest : public CliTest, public ::testing::WithParamInterface<BadOptions> {};
@@ -310,10 +317,50 @@ TEST_F(CliTest, CompareRunsEemAndMidpoint) {
   }
 }
 
+// IDA writes one row per output time and reports its statistics.
+TEST_F(CliTest, IdaRunWritesOneRowPerOutputTime) {
+  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) +
+                                 " --integrator ida --rtol 1e-8 --atol 1e-10 --dt-out 0.25 --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  ASSERT_NO_FATAL_FAILURE(expectCompleteHistory(splitLines(readFile(outDir() / "history.csv")), 4 + 1));
+  EXPECT_NE(r.out.find("error-test failures"), std::string::npos) << r.out;
+}
+
+// A small sweep: one CSV row per run with finite numbers, the three plots, a cached reference.
+TEST_F(CliTest, BenchWritesTheWorkPrecisionTableAndPlots) {
+  const std::string command = "bench " + quoted(writeScene(kSwingScene)) +
+                              " --dts 0.25,0.125 --rtols 1e-4,1e-6 --repeats 1 --out " + quoted(outDir());
+  const Invocation r = metriplex(command);
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "work_precision.csv"));
+  ASSERT_EQ(lines.size(), 1u + 3 * 2 + 2);  // eem, midpoint, trapezoidal over 2 steps; ida over 2 tolerances
+  const std::vector<std::string> header = splitFields(lines.front());
+  for (const char* column : {"integrator", "dt", "rtol", "cpu_seconds", "steps", "newton_iterations", "ida_steps",
+                             "error", "energy_drift", "entropy_violations", "status"})
+    ASSERT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
+  auto field = [&](const std::vector<std::string>& row, const char* column) {
+    return row[std::find(header.begin(), header.end(), column) - header.begin()];
+  };
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = splitFields(lines[i]);
+    ASSERT_EQ(row.size(), header.size()) << lines[i];
+    for (const char* column : {"cpu_seconds", "error", "energy_drift"})
+      EXPECT_TRUE(std::isfinite(std::stod(field(row, column)))) << lines[i];
+    EXPECT_EQ(field(row, "status"), "ok") << lines[i];
+  }
+  for (const char* plot : {"work_precision.png", "energy_error.png", "entropy.png"})
+    EXPECT_GT(fs::file_size(outDir() / plot), 1000u) << plot;
+  // the second sweep reuses the reference instead of recomputing it
+  const Invocation again = metriplex(command);
+  ASSERT_EQ(again.exitCode, kExitSuccess) << again.err;
+  EXPECT_NE(again.out.find("reference: cached"), std::string::npos) << again.out;
+}
+
 // Each help text exits 0 and lists what it documents.
 TEST_F(CliTest, HelpExitsZeroAndListsTheOptions) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> helps = {
-      {"--help", {"run", "compare", "Exit codes"}},
+      {"--help", {"run", "compare", "bench", "Exit codes"}},
+      {"bench --help", {"SCENE", "--integrators", "--dts", "--rtols", "--repeats", "--out"}},
       {"run --help", {"SCENE", "--integrator", "--dt", "--t-end", "--out"}},
       {"compare --help", {"SCENE", "--integrators", "--dt", "--t-end", "--out"}},
   };

@@ -1,0 +1,99 @@
+// The standard-method baselines on the same model: SUNDIALS IDA agrees with EEM at a small step
+// and converges as its tolerance shrinks; midpoint and trapezoidal keep the momenta the model's
+// symmetry implies.
+#include "support.hpp"
+
+#include "engine/method.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace mpx::test {
+namespace {
+
+constexpr double kEndTime = 2.0;
+
+History runIda(const Model& model, double rtol, double tEnd = kEndTime) {
+  History h;
+  MethodParameters parameters;
+  parameters.dt = tEnd / 20;
+  parameters.tEnd = tEnd;
+  parameters.relativeTolerance = rtol;
+  parameters.absoluteTolerance = rtol;
+  h.summary = runMethod(model, *methodByName("ida"), parameters, [&](const StepRecord& r) {
+    h.time.push_back(r.time);
+    h.energy.push_back(r.measures->energy);
+    h.states.push_back(*r.state);
+  });
+  EXPECT_FALSE(h.summary.failed) << h.summary.failure;
+  return h;
+}
+
+double distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return (a - b).lpNorm<Eigen::Infinity>(); }
+
+class IdaAgainstEem : public ::testing::TestWithParam<const char*> {};
+
+// IDA at rtol 1e-10 and EEM at dt = 1e-3 (error ~1e-7) give the same state at t = 2 to 1e-5,
+// positions, velocities and thermal variables alike
+TEST_P(IdaAgainstEem, TightIdaAgreesWithFineEem) {
+  const CompiledScene scene = loadScene(scenePath(GetParam()));
+  const History eem = run(*scene.model, Scheme::Eem, 1e-3, kEndTime);
+  const History ida = runIda(*scene.model, 1e-10);
+  ASSERT_DOUBLE_EQ(ida.time.back(), kEndTime);
+  const double gap = distance(eem.states.back(), ida.states.back());
+  std::printf("%s: |EEM(dt 1e-3) - IDA(rtol 1e-10)| at t = 2: %.3e\n", GetParam(), gap);
+  EXPECT_LT(gap, 1e-5);
+}
+
+// IDA's error against its own tight run falls with every tolerance step, by 100x over four
+// orders of tolerance (BDF errors are not strictly proportional to rtol)
+TEST_P(IdaAgainstEem, ErrorDecreasesWithTolerance) {
+  const CompiledScene scene = loadScene(scenePath(GetParam()));
+  const Eigen::VectorXd reference = runIda(*scene.model, 1e-11).states.back();
+  std::vector<double> errors;
+  for (double rtol : {1e-4, 1e-6, 1e-8}) {
+    errors.push_back(distance(runIda(*scene.model, rtol).states.back(), reference));
+    std::printf("%s: IDA rtol %g error %.3e\n", GetParam(), rtol, errors.back());
+    if (errors.size() > 1) EXPECT_LT(errors.back(), errors[errors.size() - 2]) << "rtol " << rtol;
+  }
+  EXPECT_LT(errors.back(), 1e-2 * errors.front());
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, IdaAgainstEem, ::testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           const std::string scene = info.param;
+                           return scene.substr(0, scene.find('.'));
+                         });
+
+// IDA does not keep the energy: its drift at rtol 1e-6 is visible where EEM's is round-off
+TEST(IdaEnergy, DriftsWhereEemDoesNot) {
+  const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));
+  const History ida = runIda(*scene.model, 1e-6, 200.0);
+  double drift = 0.0;
+  for (double e : ida.energy) drift = std::max(drift, std::abs(e - ida.energy.front()) / std::abs(ida.energy.front()));
+  std::printf("IDA rtol 1e-6 relative energy drift over t in [0, 200]: %.3e\n", drift);
+  EXPECT_GT(drift, 1e-8);
+}
+
+double maxDrift(const std::vector<Vec3>& series) {
+  double drift = 0.0;
+  for (const Vec3& v : series) drift = std::max(drift, (v - series.front()).norm() / series.front().norm());
+  return drift;
+}
+
+// a free system is translation invariant: both standard one-step rules keep its linear
+// momentum; the midpoint rule also keeps the angular momentum (the trapezoidal rule does not:
+// its end-point forces act along different directions)
+TEST(StandardMethods, KeepMomentaOfAFreeSystem) {
+  const CompiledScene scene = loadScene(scenePath("thermo_visco_elastic.xml"));
+  const History trapezoidal = run(*scene.model, Scheme::Trapezoidal, 0.1, 50.0);
+  const History midpoint = run(*scene.model, Scheme::Midpoint, 0.1, 50.0);
+  EXPECT_LE(maxDrift(trapezoidal.momentum), 1e-12);
+  EXPECT_LE(maxDrift(midpoint.momentum), 1e-12);
+  EXPECT_LE(maxDrift(midpoint.angularMomentum), 1e-12);
+  std::printf("trapezoidal angular momentum drift: %.3e\n", maxDrift(trapezoidal.angularMomentum));
+}
+
+}  // namespace
+}  // namespace mpx::test
