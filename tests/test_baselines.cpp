@@ -55,7 +55,9 @@ TEST_P(IdaAgainstEem, ErrorDecreasesWithTolerance) {
   for (double rtol : {1e-4, 1e-6, 1e-8}) {
     errors.push_back(distance(runIda(*scene.model, rtol).states.back(), reference));
     std::printf("%s: IDA rtol %g error %.3e\n", GetParam(), rtol, errors.back());
-    if (errors.size() > 1) EXPECT_LT(errors.back(), errors[errors.size() - 2]) << "rtol " << rtol;
+    if (errors.size() > 1) {
+      EXPECT_LT(errors.back(), errors[errors.size() - 2]) << "rtol " << rtol;
+    }
   }
   EXPECT_LT(errors.back(), 1e-2 * errors.front());
 }
