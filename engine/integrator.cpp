@@ -45,10 +45,8 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
                            StepOutcome& outcome) {
   const Eigen::VectorXd& scale = model_.dofScale();
   auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
-    char text[200];
-    std::snprintf(text, sizeof text, "%s (Newton iteration %d, increment %.3g, residual %.3g)", what, iteration,
-                  incrementNorm, residualNorm);
-    outcome.failure = text;
+    std::snprintf(outcome.failure, sizeof outcome.failure, "%s (Newton iteration %d, increment %.3g, residual %.3g)",
+                  what, iteration, incrementNorm, residualNorm);
     return false;
   };
   // the residual norm relative to row scales taken at the current iterate

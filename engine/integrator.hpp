@@ -35,7 +35,9 @@ struct StepOutcome {
   int iterations = 0;  // Newton iterations, all sub-steps
   int cutbacks = 0;    // halvings needed
   StepEnergy energy;
-  std::string failure;  // what failed, when not converged
+  // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
+  // recovered Newton failure does not allocate
+  char failure[200] = "";
 };
 
 class Integrator {

@@ -1,0 +1,294 @@
+// Every tangent against central differences of its residual: the assembled step system of each
+// scheme (EEM with both discrete-gradient forms, midpoint, trapezoidal) on small scenes that
+// together hold every scene element, in both thermal variables, and the components' rate form
+// alpha dF/dz + beta dF/dzdot for arbitrary alpha, beta.
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace mpx {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+constexpr double kTime = 0.7;  // inside the rising part of every load profile below
+constexpr double kTimeStep = 0.1;
+constexpr double kTolerance = 1e-6;
+
+// Stiffness curvature of the thermo-elements: only the temperature form admits one.
+std::string curvature(ThermalVariable variable) {
+  return variable == ThermalVariable::Temperature ? R"( stiffness_curvature="0.05")" : "";
+}
+
+// A spring pendulum in gravity under a constant load.
+std::string springInGravity(ThermalVariable) {
+  return R"(<gravity g="0 0 -9.81"/>
+    <anchor name="pivot" position="0 0 0"/>
+    <mass name="bob" mass="2" position="1 0 -0.5" velocity="0 1 0"/>
+    <spring name="spring" a="pivot" b="bob" stiffness="200" rest_length="1"/>
+    <force name="push" on="bob" force="0 5 0" profile="constant"/>)";
+}
+
+// Two masses joined by an isothermal Maxwell element and a dashpot, one tied to an anchor by
+// another dashpot, under ramp, hat and table loads.
+std::string maxwellWithDampers(ThermalVariable) {
+  return R"(<anchor name="pivot" position="-1 0.2 0"/>
+    <mass name="m1" mass="1" position="0 0 0" velocity="0 -0.4 0.1"/>
+    <mass name="m2" mass="2" position="1.5 0 0" velocity="0.1 0.2 -0.05"/>
+    <maxwell name="element" a="m1" b="m2" stiffness="1" rest_length="1" branch_stiffness="2" viscosity="1"
+             viscous_elongation="0.1"/>
+    <damper name="between" a="m1" b="m2" coefficient="0.5"/>
+    <damper name="to_pivot" a="pivot" b="m1" coefficient="0.3"/>
+    <force name="ramp" on="m1" force="0 1 0" profile="ramp" start="0" end="2"/>
+    <force name="hat" on="m2" force="0.5 0 0" profile="hat" period="4"/>
+    <force name="table" on="m2" force="0 0 1" profile="table" times="0 0.5 1 2" values="0 1 -0.5 2"/>)";
+}
+
+// A thermo-spring with temperature-dependent stiffness, conducting to a prescribed temperature.
+std::string thermoSpringToWall(ThermalVariable variable) {
+  return R"(<anchor name="pivot" position="0 0 0"/>
+    <mass name="bob" mass="1" position="1.2 0 0" velocity="0 1 0"/>
+    <thermo_spring name="spring" a="pivot" b="bob" stiffness="1" stiffness_slope="-0.2")" +
+         curvature(variable) + R"( coupling="0.5" rest_length="1" heat_capacity="1" reference_temperature="1"
+                   temperature="1"/>
+    <fixed_temperature name="wall" temperature="2"/>
+    <heat_link name="to_wall" a="spring" b="wall" conductivity="0.2"/>)";
+}
+
+// A thermo-Maxwell element with temperature-dependent viscosity and a thermo-spring sharing a
+// mass, both conducting to each other and to a reservoir, in gravity.
+std::string thermoMaxwellChain(ThermalVariable variable) {
+  return R"(<gravity g="0 0 -1"/>
+    <mass name="m1" mass="1" position="0 0 0" velocity="0 -0.4 0.1"/>
+    <mass name="m2" mass="2" position="1.5 0 0" velocity="0.1 0.2 -0.05"/>
+    <mass name="m3" mass="1" position="1.9 1.1 0.2" velocity="0 0 0.3"/>
+    <thermo_maxwell name="visco" a="m1" b="m2" stiffness="1" stiffness_slope="-0.1")" +
+         curvature(variable) + R"( coupling="0.5" rest_length="1" heat_capacity="1" reference_temperature="1"
+                    branch_stiffness="2" viscosity="1" viscosity_activation="0.5" viscous_strain="0.05"
+                    temperature="1.2"/>
+    <thermo_spring name="spring" a="m2" b="m3" stiffness="2" coupling="0.3" rest_length="1" heat_capacity="2"
+                   reference_temperature="1" temperature="0.9"/>
+    <reservoir name="environment" heat_capacity="5" reference_temperature="1" temperature="1"/>
+    <heat_link name="between" a="visco" b="spring" conductivity="0.7"/>
+    <heat_link name="visco_out" a="visco" b="environment" conductivity="0.5"/>
+    <heat_link name="spring_out" a="environment" b="spring" conductivity="0.3"/>)";
+}
+
+struct SceneBody {
+  const char* name;
+  std::string (*body)(ThermalVariable);
+};
+
+const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity},
+                             {"maxwell_with_dampers", maxwellWithDampers},
+                             {"thermo_spring_to_wall", thermoSpringToWall},
+                             {"thermo_maxwell_chain", thermoMaxwellChain}};
+
+std::string variableName(ThermalVariable variable) {
+  return variable == ThermalVariable::Temperature ? "temperature" : "entropy";
+}
+
+CompiledScene compile(const SceneBody& scene, ThermalVariable variable, DiscreteGradientForm form) {
+  const std::string simulation = R"(<simulation dt="0.1" t_end="10" discrete_gradient=")" +
+                                 std::string(form == DiscreteGradientForm::Gonzalez ? "gonzalez" : "partitioned") +
+                                 R"("/>)";
+  return loadSceneText("<metriplex>" + simulation + scene.body(variable) + "</metriplex>", scene.name, variable);
+}
+
+// A fixed pseudo-random vector: entries +-[0.5, 1] times `magnitude`, never near zero.
+VectorXd randomIsh(const VectorXd& magnitude, unsigned seed) {
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> size(0.5, 1.0);
+  std::bernoulli_distribution negative(0.5);
+  VectorXd out(magnitude.size());
+  for (Eigen::Index i = 0; i < out.size(); ++i)
+    out[i] = (negative(generator) ? -1.0 : 1.0) * size(generator) * magnitude[i];
+  return out;
+}
+
+// Typical magnitude of each dof at z: |z_i| plus the model's scale.
+VectorXd magnitudeAt(const Model& model, const VectorXd& z) { return z.cwiseAbs() + model.dofScale(); }
+
+using ResidualFunction = std::function<VectorXd(const VectorXd&)>;
+
+// Central differences of `residual` at x, column j with step relativeStep * magnitude_j.
+MatrixXd centralDifferences(const ResidualFunction& residual, const VectorXd& x, const VectorXd& magnitude,
+                            double relativeStep) {
+  MatrixXd jacobian(x.size(), x.size());
+  for (Eigen::Index j = 0; j < x.size(); ++j) {
+    const double h = relativeStep * magnitude[j];
+    VectorXd forward = x, backward = x;
+    forward[j] += h;
+    backward[j] -= h;
+    jacobian.col(j) = (residual(forward) - residual(backward)) / (2.0 * h);
+  }
+  return jacobian;
+}
+
+// Each row's largest mismatch relative to the row's largest term, with columns weighted by
+// the dof magnitudes so that entries of different units compare alike; the worst row wins.
+struct Mismatch {
+  double relative = 0.0;
+  Eigen::Index row = 0, col = 0;
+};
+
+Mismatch worstRowMismatch(const MatrixXd& analytic, const MatrixXd& numeric, const VectorXd& magnitude) {
+  const MatrixXd weight = VectorXd::Ones(analytic.rows()) * magnitude.transpose();
+  const MatrixXd error = (analytic - numeric).cwiseAbs().cwiseProduct(weight);
+  const MatrixXd size = analytic.cwiseAbs().cwiseMax(numeric.cwiseAbs()).cwiseProduct(weight);
+  Mismatch worst;
+  for (Eigen::Index i = 0; i < analytic.rows(); ++i) {
+    const double rowSize = size.row(i).maxCoeff();
+    if (rowSize == 0.0) continue;
+    Eigen::Index col = 0;
+    const double relative = error.row(i).maxCoeff(&col) / rowSize;
+    if (relative > worst.relative) worst = {relative, i, col};
+  }
+  return worst;
+}
+
+void expectTangentMatches(const Model& model, const MatrixXd& analytic, const MatrixXd& numeric,
+                          const VectorXd& magnitude) {
+  const Mismatch worst = worstRowMismatch(analytic, numeric, magnitude);
+  const Layout& layout = model.layout();
+  EXPECT_LT(worst.relative, kTolerance) << "row " << worst.row << " (" << blockName(layout.blockOf(worst.row))
+                                        << "), column " << worst.col << " (" << blockName(layout.blockOf(worst.col))
+                                        << "): tangent " << analytic(worst.row, worst.col) << ", finite differences "
+                                        << numeric(worst.row, worst.col);
+}
+
+struct StepCase {
+  const SceneBody* scene;
+  ThermalVariable variable;
+  DiscreteGradientForm form;
+  Scheme scheme;
+};
+
+void PrintTo(const StepCase& c, std::ostream* out) { *out << c.scene->name; }
+
+std::string schemeName(Scheme scheme) {
+  switch (scheme) {
+    case Scheme::Eem: return "eem";
+    case Scheme::Midpoint: return "midpoint";
+    case Scheme::Trapezoidal: return "trapezoidal";
+  }
+  return "unknown";
+}
+
+std::vector<StepCase> stepCases() {
+  std::vector<StepCase> cases;
+  for (const SceneBody& scene : kScenes)
+    for (ThermalVariable variable : {ThermalVariable::Temperature, ThermalVariable::Entropy})
+      for (DiscreteGradientForm form : {DiscreteGradientForm::Partitioned, DiscreteGradientForm::Gonzalez})
+        for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal}) {
+          // the discrete-gradient form only matters to EEM
+          if (scheme != Scheme::Eem && form == DiscreteGradientForm::Gonzalez) continue;
+          cases.push_back({&scene, variable, form, scheme});
+        }
+  return cases;
+}
+
+class StepTangent : public testing::TestWithParam<StepCase> {
+ protected:
+  void SetUp() override {
+    const StepCase& c = GetParam();
+    scene_ = compile(*c.scene, c.variable, c.form);
+    integrator_.emplace(*scene_.model, c.scheme, NewtonSettings{});
+    zOld_ = scene_.model->initialState();
+  }
+
+  // The step's tangent at zNew against central differences of its residual.
+  void expectTangentMatchesAt(const VectorXd& zNew, double relativeStep) {
+    Integrator& integrator = *integrator_;
+    const MatrixXd analytic(integrator.evaluate(zOld_, zNew, kTime, kTimeStep).tangent());
+    const auto residual = [&](const VectorXd& z) -> VectorXd {
+      return integrator.evaluate(zOld_, z, kTime, kTimeStep).residual();
+    };
+    const VectorXd magnitude = magnitudeAt(*scene_.model, zNew);
+    expectTangentMatches(*scene_.model, analytic, centralDifferences(residual, zNew, magnitude, relativeStep),
+                         magnitude);
+  }
+
+  CompiledScene scene_;
+  std::optional<Integrator> integrator_;
+  VectorXd zOld_;
+};
+
+// A generic end point, 1e-2 relative away from zOld in every dof: every difference quotient
+// of the discrete gradients is taken (increments far above kQuotientSwitch).
+TEST_P(StepTangent, MatchesFiniteDifferencesAwayFromOldState) {
+  const VectorXd zNew = zOld_ + 1e-2 * randomIsh(magnitudeAt(*scene_.model, zOld_), 7);
+  expectTangentMatchesAt(zNew, 1e-6);
+}
+
+// zNew = zOld, where Newton starts every step: the quotients' midpoint limits are in use, and
+// differencing steps of 1e-7 stay below kQuotientSwitch.
+TEST_P(StepTangent, MatchesFiniteDifferencesAtOldState) { expectTangentMatchesAt(zOld_, 1e-7); }
+
+INSTANTIATE_TEST_SUITE_P(AllElements, StepTangent, testing::ValuesIn(stepCases()),
+                         [](const testing::TestParamInfo<StepCase>& info) {
+                           const StepCase& c = info.param;
+                           return std::string(c.scene->name) + "_" + variableName(c.variable) + "_" +
+                                  schemeName(c.scheme) +
+                                  (c.form == DiscreteGradientForm::Gonzalez ? "_gonzalez" : "");
+                         });
+
+// The rate form F(t, z, zdot) of every component, assembled densely in the model's order (heat
+// links after the owners that publish their node temperatures), with its tangent
+// alpha dF/dz + beta dF/dzdot.
+struct DenseSystem {
+  VectorXd residual;
+  MatrixXd tangent;
+};
+
+DenseSystem assembleRate(const Model& model, const VectorXd& z, const VectorXd& zdot, double alpha, double beta) {
+  Workspace workspace = model.makeWorkspace();
+  const int n = model.layout().total();
+  DenseSystem out{VectorXd::Zero(n), MatrixXd::Zero(n, n)};
+  double localResidual[kMaxLocalDofs], localTangent[kMaxLocalDofs * kMaxLocalDofs];
+  for (const auto& component : model.components()) {
+    const std::vector<int>& dofs = component->dofs();
+    LocalSystem local{static_cast<int>(dofs.size()), localResidual, localTangent};
+    local.residual().setZero();
+    local.tangent().setZero();
+    Flows flows;
+    component->rateLocal({z.data(), zdot.data(), kTime, alpha, beta}, workspace, local, flows);
+    for (int i = 0; i < local.n; ++i) {
+      out.residual[dofs[i]] += local.r[i];
+      for (int j = 0; j < local.n; ++j) out.tangent(dofs[i], dofs[j]) += local.tangent()(i, j);
+    }
+  }
+  return out;
+}
+
+// alpha dF/dz + beta dF/dzdot with alpha = 0.7, beta = 1.3 (no scheme's pair), z and zdot
+// differenced separately, so a z-derivative scaled by beta or a zdot-derivative by alpha shows.
+TEST(RateTangent, MatchesSeparateFiniteDifferencesInStateAndRate) {
+  const double alpha = 0.7, beta = 1.3;
+  for (const SceneBody& scene : kScenes)
+    for (ThermalVariable variable : {ThermalVariable::Temperature, ThermalVariable::Entropy}) {
+      SCOPED_TRACE(std::string(scene.name) + ", " + variableName(variable));
+      const CompiledScene compiled = compile(scene, variable, DiscreteGradientForm::Partitioned);
+      const Model& model = *compiled.model;
+      const VectorXd& z0 = model.initialState();
+      const VectorXd z = z0 + 1e-2 * randomIsh(magnitudeAt(model, z0), 11);
+      const VectorXd magnitude = magnitudeAt(model, z);
+      const VectorXd zdot = randomIsh(magnitude, 13);
+      const auto inState = [&](const VectorXd& x) { return assembleRate(model, x, zdot, alpha, beta).residual; };
+      const auto inRate = [&](const VectorXd& x) { return assembleRate(model, z, x, alpha, beta).residual; };
+      const MatrixXd numeric = alpha * centralDifferences(inState, z, magnitude, 1e-6) +
+                               beta * centralDifferences(inRate, zdot, magnitude, 1e-6);
+      expectTangentMatches(model, assembleRate(model, z, zdot, alpha, beta).tangent, numeric, magnitude);
+    }
+}
+
+}  // namespace
+}  // namespace mpx
