@@ -6,7 +6,7 @@
 #include "models/external_force.hpp"
 #include "models/fixed_temperature.hpp"
 #include "models/heat_link.hpp"
-#include "models/point_mass.hpp"
+#include "models/inertia.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -250,7 +250,8 @@ void SceneCompiler::addMass(ElementReader& in) {
   state_.segment<3>(end.velocityDof) = in.vector("velocity", Vec3::Zero());
   keepPositionScale(state_.segment<3>(end.positionDof).norm());
   points_[name] = end;
-  components_.push_back(std::make_unique<PointMass>(name, mass, end.positionDof, end.velocityDof, gravity_));
+  components_.push_back(
+      std::make_unique<Inertia>(name, end.positionDof, end.velocityDof, std::vector<InertiaBlock>{{mass, true}}, gravity_));
 }
 
 void SceneCompiler::addAnchor(ElementReader& in) {
