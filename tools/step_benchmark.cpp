@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -41,7 +42,8 @@ std::string thermoSpringChainXml(int masses, double dt) {
         << "  <thermo_spring name=\"s" << i << "\" a=\"" << point(i - 1) << "\" b=\"" << point(i)
         << "\" stiffness=\"1\" coupling=\"1\" rest_length=\"1\" heat_capacity=\"1\""
         << " reference_temperature=\"1\" temperature=\"" << 1.0 + 0.5 * std::sin(i) << "\"/>\n";
-    if (i > 1) xml << "  <heat_link name=\"h" << i << "\" a=\"s" << i - 1 << "\" b=\"s" << i << "\" conductivity=\"1\"/>\n";
+    if (i > 1)
+      xml << "  <heat_link name=\"h" << i << "\" a=\"s" << i - 1 << "\" b=\"s" << i << "\" conductivity=\"1\"/>\n";
   }
   xml << "</metriplex>\n";
   return xml.str();
@@ -73,6 +75,8 @@ void stepBenchmark(benchmark::State& state, const std::shared_ptr<const Compiled
   state.counters["t_reached"] = t;
 }
 
+// A scheme as the command line names it: the EEM cases fix the thermal variable, the
+// standard rules run in the one the scene declares.
 struct SchemeChoice {
   const char* name;
   Scheme scheme;
@@ -85,7 +89,8 @@ const SchemeChoice kMidpoint{"midpoint", Scheme::Midpoint, std::nullopt};
 const SchemeChoice kTrapezoidal{"trapezoidal", Scheme::Trapezoidal, std::nullopt};
 
 // Compile the scene once per case (outside any timing) and register its step benchmark.
-void registerCases(const std::string& sceneName, const SceneSource& source, std::initializer_list<SchemeChoice> choices) {
+void registerCases(const std::string& sceneName, const SceneSource& source,
+                   std::initializer_list<SchemeChoice> choices) {
   for (const SchemeChoice& choice : choices) {
     auto scene = std::make_shared<const CompiledScene>(source(choice.variable));
     benchmark::RegisterBenchmark((sceneName + "/" + choice.name).c_str(), stepBenchmark, scene, choice.scheme)
@@ -99,6 +104,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
 
+  // every case is registered; --benchmark_filter picks which run
   registerCases("two_thermo_springs", sceneFile("two_thermo_springs.xml"),
                 {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
   registerCases("thermo_visco_elastic", sceneFile("thermo_visco_elastic.xml"),
