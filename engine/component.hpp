@@ -11,9 +11,9 @@ namespace mpx {
 
 using Vec3 = Eigen::Vector3d;
 
-// Largest number of local dofs of one component (two mass points, thermal and internal
-// variables, or a heat link between two such elements).
-inline constexpr int kMaxLocalDofs = 32;
+// Largest number of local dofs of one component: a joint between two rigid bodies touches
+// 2 x 12 positions and their 24 velocity rows plus its multipliers.
+inline constexpr int kMaxLocalDofs = 56;
 
 // Temperature of a thermal node as seen by the heat links that touch it: the discrete
 // temperature theta~ in an EEM step, theta(z) in a rate evaluation. The owner publishes it

@@ -7,8 +7,11 @@
 #include "models/fixed_temperature.hpp"
 #include "models/heat_link.hpp"
 #include "models/inertia.hpp"
+#include "models/joint_builder.hpp"
 
 #include <algorithm>
+#include <Eigen/Eigenvalues>
+
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -25,6 +28,12 @@ bool ownsThermalDof(const std::string& tag) {
   return tag == "thermo_spring" || tag == "thermo_maxwell" || tag == "reservoir";
 }
 bool ownsInternalDof(const std::string& tag) { return tag == "maxwell" || tag == "thermo_maxwell"; }
+
+// How a set of constraints is enforced.
+struct ConstraintSettings {
+  Enforcement enforcement = Enforcement::AugmentedLagrangian;
+  double stiffness = 1e6;
+};
 
 class SceneCompiler {
  public:
@@ -47,6 +56,14 @@ class SceneCompiler {
   void addFixedTemperature(ElementReader& in);
   void addHeatLink(ElementReader& in);
   void addForce(ElementReader& in);
+  void addBody(ElementReader& in);
+  void addJoint(ElementReader& in);
+  // Penalty or augmented-Lagrangian enforcement of `forms`, with multipliers when needed.
+  void addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
+                     const ConstraintSettings& settings);
+  ConstraintSettings constraintSettings(ElementReader& in);
+  // Scalar constraints an element adds to the multiplier block (pre-pass count).
+  int multipliersOf(const XMLElement& element) const;
 
   std::string declareName(ElementReader& in);
   Endpoint endpoint(ElementReader& in, const char* attribute);
@@ -72,7 +89,9 @@ class SceneCompiler {
   std::map<std::string, Endpoint> points_;  // masses and anchors
   std::map<std::string, ThermalNodeRef> thermalNodes_;
   std::map<std::string, int> names_;  // every declared name -> line
-  int massCount_ = 0, thermalCount_ = 0, internalCount_ = 0;
+  std::map<std::string, Attachment> attachments_;  // what joints may attach to
+  ConstraintSettings constraintDefaults_;
+  int positionCount_ = 0, thermalCount_ = 0, internalCount_ = 0, multiplierCount_ = 0;
   double positionScale_ = 0.0;
 };
 
@@ -83,14 +102,15 @@ CompiledScene SceneCompiler::compile() {
   readSettings();
 
   // the layout from a count of what owns dofs
-  int masses = 0, thermal = 0, internal = 0;
+  int positions = 0, thermal = 0, internal = 0, multipliers = 0;
   for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
-    masses += tag == "mass";
+    positions += tag == "mass" ? 3 : tag == "body" ? 12 : 0;
     thermal += ownsThermalDof(tag);
     internal += ownsInternalDof(tag);
+    multipliers += multipliersOf(*e);
   }
-  layout_ = Layout({3 * masses, 3 * masses, thermal, internal, 0});
+  layout_ = Layout({positions, positions, thermal, internal, multipliers});
   state_ = Eigen::VectorXd::Zero(layout_.total());
   scale_ = Eigen::VectorXd::Zero(layout_.total());
 
@@ -126,6 +146,9 @@ void SceneCompiler::readSettings() {
       readSolver(in);
     } else if (tag == "gravity") {
       gravity_ = in.vector("g", Vec3::Zero());
+      in.finish();
+    } else if (tag == "constraints") {
+      constraintDefaults_ = constraintSettings(in);
       in.finish();
     }
   }
@@ -170,7 +193,7 @@ void SceneCompiler::readSolver(ElementReader& in) {
 void SceneCompiler::addElement(const XMLElement& element) {
   const std::string tag = element.Name();
   ElementReader in(element, file_);
-  if (tag == "simulation" || tag == "solver" || tag == "gravity") return;  // read by readSettings
+  if (tag == "simulation" || tag == "solver" || tag == "gravity" || tag == "constraints") return;  // readSettings
   if (tag == "mass") addMass(in);
   else if (tag == "anchor") addAnchor(in);
   else if (tag == "spring") addSpring(in, false);
@@ -182,6 +205,8 @@ void SceneCompiler::addElement(const XMLElement& element) {
   else if (tag == "fixed_temperature") addFixedTemperature(in);
   else if (tag == "heat_link") addHeatLink(in);
   else if (tag == "force") addForce(in);
+  else if (tag == "body") addBody(in);
+  else if (tag == "joint") addJoint(in);
   else in.fail("unknown element (see docs/scene-format.md for the elements a scene may hold)");
   in.finish();
 }
@@ -244,12 +269,14 @@ void SceneCompiler::addLumpedElement(LumpedElementSpec spec) {
 void SceneCompiler::addMass(ElementReader& in) {
   const std::string name = declareName(in);
   const double mass = in.positive("mass");
-  const int index = massCount_++;
-  const Endpoint end{layout_.dof(Block::Position, 3 * index), layout_.dof(Block::Velocity, 3 * index), Vec3::Zero()};
+  const Endpoint end{layout_.dof(Block::Position, positionCount_), layout_.dof(Block::Velocity, positionCount_),
+                     Vec3::Zero()};
+  positionCount_ += 3;
   state_.segment<3>(end.positionDof) = in.vector("position", Vec3::Zero());
   state_.segment<3>(end.velocityDof) = in.vector("velocity", Vec3::Zero());
   keepPositionScale(state_.segment<3>(end.positionDof).norm());
   points_[name] = end;
+  attachments_[name] = Attachment{Attachment::Kind::Point, end.positionDof, state_.segment<3>(end.positionDof), Mat3::Identity()};
   components_.push_back(
       std::make_unique<Inertia>(name, end.positionDof, end.velocityDof, std::vector<InertiaBlock>{{mass, true}}, gravity_));
 }
@@ -260,6 +287,7 @@ void SceneCompiler::addAnchor(ElementReader& in) {
   end.anchor = in.vector("position", Vec3::Zero());
   keepPositionScale(end.anchor.norm());
   points_[name] = end;
+  attachments_[name] = Attachment{Attachment::Kind::Ground, -1, end.anchor, Mat3::Identity()};
 }
 
 void SceneCompiler::addSpring(ElementReader& in, bool withBranch) {
@@ -402,6 +430,132 @@ void SceneCompiler::addForce(ElementReader& in) {
     in.fail("profile must be constant, ramp, hat or table, got '" + profile + "'");
   }
   components_.push_back(std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, std::move(f)));
+}
+
+ConstraintSettings SceneCompiler::constraintSettings(ElementReader& in) {
+  ConstraintSettings settings = constraintDefaults_;
+  const std::string enforcement = in.text("enforcement", settings.enforcement == Enforcement::Penalty ? "penalty" : "augmented_lagrangian");
+  if (enforcement != "penalty" && enforcement != "augmented_lagrangian")
+    in.fail("enforcement must be 'penalty' or 'augmented_lagrangian', got '" + enforcement + "'");
+  settings.enforcement = enforcement == "penalty" ? Enforcement::Penalty : Enforcement::AugmentedLagrangian;
+  settings.stiffness = in.positive("stiffness", settings.stiffness);
+  return settings;
+}
+
+int SceneCompiler::multipliersOf(const XMLElement& element) const {
+  const std::string tag = element.Name();
+  if (tag != "body" && tag != "joint") return 0;
+  const char* enforcement = element.Attribute("enforcement");
+  const bool augmented = enforcement ? std::string(enforcement) == "augmented_lagrangian"
+                                     : constraintDefaults_.enforcement == Enforcement::AugmentedLagrangian;
+  if (!augmented) return 0;
+  if (tag == "body") return 6;
+  const char* type = element.Attribute("type");
+  const std::optional<JointType> joint = type ? jointTypeByName(type) : std::nullopt;
+  return joint ? constraintCount(*joint) : 0;  // a bad type is reported when the joint is read
+}
+
+void SceneCompiler::addConstraint(const std::string& name, const JointBuilder& builder,
+                                  std::vector<QuadraticForm> forms, const ConstraintSettings& settings) {
+  ConstraintSpec spec;
+  spec.name = name;
+  spec.positionDofs = builder.positionDofs();
+  spec.velocityShift = layout_.offset(Block::Velocity) - layout_.offset(Block::Position);
+  spec.enforcement = settings.enforcement;
+  spec.stiffness = settings.stiffness;
+  if (settings.enforcement == Enforcement::AugmentedLagrangian) {
+    spec.firstMultiplierDof = layout_.dof(Block::Multiplier, multiplierCount_);
+    for (std::size_t k = 0; k < forms.size(); ++k) scale_[spec.firstMultiplierDof + k] = 1.0;
+    multiplierCount_ += static_cast<int>(forms.size());
+  }
+  spec.forms = std::move(forms);
+  components_.push_back(std::make_unique<QuadraticConstraint>(std::move(spec)));
+}
+
+void SceneCompiler::addBody(ElementReader& in) {
+  const std::string name = declareName(in);
+  const double mass = in.positive("mass");
+  const std::vector<double> inertia = in.numbers("inertia");
+  if (inertia.size() != 3 && inertia.size() != 6)
+    in.fail("inertia needs 3 (Ixx Iyy Izz) or 6 (Ixx Iyy Izz Ixy Ixz Iyz) numbers, got " +
+            std::to_string(inertia.size()));
+  Mat3 tensor = Vec3(inertia[0], inertia[1], inertia[2]).asDiagonal();
+  if (inertia.size() == 6) {
+    tensor(0, 1) = tensor(1, 0) = inertia[3];
+    tensor(0, 2) = tensor(2, 0) = inertia[4];
+    tensor(1, 2) = tensor(2, 1) = inertia[5];
+  }
+  const std::vector<double> q = in.has("orientation") ? in.numbers("orientation") : std::vector<double>{1, 0, 0, 0};
+  if (q.size() != 4) in.fail("orientation needs a quaternion: 4 numbers w x y z");
+  const Eigen::Quaterniond orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  const Vec3 position = in.vector("position", Vec3::Zero());
+  const Vec3 velocity = in.vector("velocity", Vec3::Zero());
+  const Vec3 angularVelocity = in.vector("angular_velocity", Vec3::Zero());
+  const ConstraintSettings rigidity = constraintSettings(in);
+
+  // principal axes of the inertia tensor (given in the body frame) become the directors
+  const Mat3 rotation = orientation.toRotationMatrix();
+  const Eigen::SelfAdjointEigenSolver<Mat3> principal(rotation * tensor * rotation.transpose());
+  const Vec3 J = principal.eigenvalues();
+  Mat3 directors = principal.eigenvectors();
+  if (directors.determinant() < 0) directors.col(2) *= -1.0;
+  if (!(J.minCoeff() > 0.0)) in.fail("the inertia tensor must be positive definite");
+  const Vec3 E(0.5 * (J[1] + J[2] - J[0]), 0.5 * (J[2] + J[0] - J[1]), 0.5 * (J[0] + J[1] - J[2]));
+  if (!(E.minCoeff() > 0.0))
+    in.fail("principal moments must satisfy the strict triangle inequality J_i < J_j + J_k "
+            "(the director mass matrix needs (J_j + J_k - J_i)/2 > 0)");
+
+  const int phi = layout_.dof(Block::Position, positionCount_), phiRate = layout_.dof(Block::Velocity, positionCount_);
+  positionCount_ += 12;
+  state_.segment<3>(phi) = position;
+  state_.segment<3>(phiRate) = velocity;
+  for (int i = 0; i < 3; ++i) {
+    state_.segment<3>(phi + 3 + 3 * i) = directors.col(i);
+    state_.segment<3>(phiRate + 3 + 3 * i) = angularVelocity.cross(directors.col(i));
+  }
+  keepPositionScale(position.norm());
+  points_[name] = Endpoint{phi, phiRate, Vec3::Zero()};
+  attachments_[name] = Attachment{Attachment::Kind::Body, phi, position, directors};
+  components_.push_back(std::make_unique<Inertia>(
+      name, phi, phiRate, std::vector<InertiaBlock>{{mass, true}, {E[0], false}, {E[1], false}, {E[2], false}},
+      gravity_));
+  const JointBuilder builder(attachments_[name], Attachment{});
+  addConstraint(name + ".rigidity", builder, builder.rigidity(), rigidity);
+}
+
+void SceneCompiler::addJoint(ElementReader& in) {
+  const std::string name = declareName(in);
+  const std::string typeName = in.text("type");
+  const std::optional<JointType> type = jointTypeByName(typeName);
+  if (!type)
+    in.fail("unknown joint type '" + typeName +
+            "' (choose spherical, revolute, universal, cylindrical, prismatic, fixed, distance)");
+  auto attachment = [&](const char* attribute) {
+    const std::string target = in.text(attribute);
+    const auto it = attachments_.find(target);
+    if (it == attachments_.end())
+      in.fail(std::string("attribute '") + attribute + "': no body, mass or anchor named '" + target +
+              "' declared above this element");
+    return it->second;
+  };
+  const Attachment a = attachment("a"), b = attachment("b");
+  JointGeometry geometry;
+  geometry.anchor = in.vector("anchor", b.position);
+  geometry.anchorB = in.vector("anchor_b", b.position);
+  geometry.axis = in.vector("axis", Vec3::UnitZ());
+  geometry.axisB = in.vector("axis_b", Vec3::UnitX());
+  if (!(geometry.axis.norm() > 0.0) || !(geometry.axisB.norm() > 0.0)) in.fail("joint axes must be non-zero");
+  geometry.axis.normalize();
+  geometry.axisB.normalize();
+  if (*type == JointType::Distance && !((geometry.anchor - geometry.anchorB).norm() > 0.0))
+    in.fail("a distance joint needs anchor and anchor_b apart");
+  const ConstraintSettings settings = constraintSettings(in);
+  const JointBuilder builder(a, b);
+  try {
+    addConstraint(name, builder, builder.joint(*type, geometry), settings);
+  } catch (const std::invalid_argument& e) {
+    in.fail(e.what());
+  }
 }
 
 CompiledScene compileDocument(tinyxml2::XMLDocument& document, const std::string& label,
