@@ -2,6 +2,8 @@
 
 #include "assembler.hpp"
 
+#include <Eigen/SparseLU>
+
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -32,7 +34,7 @@ class IdaProblem {
   IdaProblem(const IdaProblem&) = delete;
   IdaProblem& operator=(const IdaProblem&) = delete;
 
-  // Consistent initial rates for the initial state (IDACalcIC); false on failure.
+  // Consistent initial rates (and multipliers) for the initial state; false on failure.
   bool initialise(double firstOutput);
   // Integrate to tout; false on failure (see error()).
   bool advanceTo(double tout);
@@ -46,6 +48,9 @@ class IdaProblem {
                       N_Vector, N_Vector, N_Vector);
   static void errorHandler(int code, const char* module, const char* function, char* message, void* self);
   void evaluate(double t, N_Vector y, N_Vector yp, double cj);
+  // Index-2 models (GGL constraints): solve the differential rows together with the time
+  // derivatives of the algebraic rows for the rates and the multipliers, then hand them to IDA.
+  bool initialiseAlgebraic();
   void check(int flag, const char* call) const;
 
   const Model& model_;
@@ -80,7 +85,11 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
     atol[i] = options.absoluteTolerance * (i < modelSize_ ? model.dofScale()[i] : 1.0);
   }
   N_VConst(0.0, yp_);
-  N_VConst(1.0, id_);  // every unknown of the rate form is differential
+  // multipliers are algebraic (and left out of the error test: the GGL form has index 2);
+  // every other unknown of the rate form is differential
+  double* id = N_VGetArrayPointer(id_);
+  const Layout& layout = model.layout();
+  for (int i = 0; i < n; ++i) id[i] = i < modelSize_ && layout.blockOf(i) == Block::Multiplier ? 0.0 : 1.0;
 
   ida_ = IDACreate(context_);
   check(IDASetErrHandlerFn(ida_, errorHandler, this), "IDASetErrHandlerFn");
@@ -88,6 +97,7 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   check(IDASVtolerances(ida_, options.relativeTolerance, atol_), "IDASVtolerances");
   check(IDASetUserData(ida_, this), "IDASetUserData");
   check(IDASetId(ida_, id_), "IDASetId");
+  check(IDASetSuppressAlg(ida_, SUNTRUE), "IDASetSuppressAlg");
   check(IDASetMaxOrd(ida_, options.maxOrder), "IDASetMaxOrd");
   check(IDASetMaxNumSteps(ida_, 1000000), "IDASetMaxNumSteps");
 
@@ -168,7 +178,56 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
 }
 
 bool IdaProblem::initialise(double firstOutput) {
+  if (model_.layout().has(Block::Multiplier)) return initialiseAlgebraic();
   return IDACalcIC(ida_, IDA_YA_YDP_INIT, firstOutput) >= 0 && IDAGetConsistentIC(ida_, y_, yp_) >= 0;
+}
+
+bool IdaProblem::initialiseAlgebraic() {
+  // IDACalcIC handles index 1 only. The rate form is linear in the rates and the multipliers,
+  // so one linear solve from (rates, multipliers) = 0 is exact: differential rows F = 0, and
+  // for each algebraic row (no rate, no multiplier in it) dF/dz . zdot = 0.
+  const Layout& layout = model_.layout();
+  const int n = modelSize_;
+  N_VConst(0.0, yp_);
+  double* y = N_VGetArrayPointer(y_);
+  for (int i = layout.offset(Block::Multiplier); i < n; ++i) y[i] = 0.0;
+  evaluate(0.0, y_, yp_, 0.0);  // alpha = 1, beta = 0: F and dF/dz
+  const Eigen::VectorXd residual = assembler_.residual();
+  const Eigen::SparseMatrix<double> dFdz = assembler_.tangent();
+  assembler_.clear();
+  assembler_.addRate(model_, workspace_, {y, N_VGetArrayPointer(yp_), 0.0, 0.0, 1.0}, 1.0);
+  const Eigen::SparseMatrix<double>& dFdzdot = assembler_.tangent();
+
+  // unknown j: the rate of a differential dof, or the value of a multiplier
+  auto algebraic = [&](int i) { return layout.blockOf(i) == Block::Multiplier; };
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::VectorXd rhs = -residual;
+  // a row is algebraic when it has no rate in it
+  std::vector<bool> hasRate(n, false);
+  for (int col = 0; col < n; ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
+      if (it.value() != 0.0) hasRate[it.row()] = true;
+  for (int col = 0; col < n; ++col) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdz, col); it; ++it) {
+      if (!hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());  // dF_a/dz . zdot
+      if (hasRate[it.row()] && algebraic(col)) entries.emplace_back(it.row(), col, it.value());    // multipliers
+    }
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
+      if (hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());
+  }
+  for (int i = 0; i < n; ++i)
+    if (!hasRate[i]) rhs[i] = 0.0;
+  Eigen::SparseMatrix<double> system(n, n);
+  system.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(system);
+  if (lu.info() != Eigen::Success) {
+    error_ = "consistent initial conditions: singular system (redundant constraints or inconsistent initial state?)";
+    return false;
+  }
+  const Eigen::VectorXd solution = lu.solve(rhs);
+  double* yp = N_VGetArrayPointer(yp_);
+  for (int i = 0; i < n; ++i) (algebraic(i) ? y[i] : yp[i]) = solution[i];
+  return IDAReInit(ida_, 0.0, y_, yp_) >= 0;
 }
 
 bool IdaProblem::advanceTo(double tout) {
@@ -213,7 +272,8 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
     summary.failure = what + ": " + ida.error();
   };
   // IDACalcIC takes its step scale from the first output time: keep that short
-  if (!ida.initialise(std::min(options.outputStep, 0.01 * options.tEnd))) fail(0, 0.0, "IDACalcIC failed");
+  if (!ida.initialise(std::min(options.outputStep, 0.01 * options.tEnd)))
+    fail(0, 0.0, "consistent initial conditions failed");
   long previousIterations = 0, previousErrorTestFailures = 0;
   for (int k = 1; k <= outputs && !summary.failed; ++k) {
     const double tout = k == outputs ? options.tEnd : k * options.outputStep;

@@ -8,7 +8,9 @@
 // multiplier dof per constraint, solved by Newton together with the positions from the row
 // Phi(q') = 0, so the constraint holds at every step to Newton's tolerance and the energy
 // (which includes lambda Phi) is exact; kappa regularises the saddle point. The rate form
-// (midpoint, trapezoidal, IDA) runs the penalty form with the multipliers held at their values.
+// (midpoint, trapezoidal, IDA) is the stabilised index-2 GGL form with a second multiplier mu
+// per constraint: q' - v + mu grad Phi = 0, Phi(q) = 0, grad Phi . v = 0 (the multiplier
+// block is algebraic for IDA).
 #include "engine/component.hpp"
 
 #include <vector>
@@ -37,7 +39,7 @@ struct ConstraintSpec {
   std::vector<QuadraticForm> forms;
   Enforcement enforcement = Enforcement::Penalty;
   double stiffness = 0.0;
-  int firstMultiplierDof = -1;  // augmented Lagrangian: one multiplier per form
+  int firstMultiplierDof = -1;  // augmented Lagrangian: lambda_k then mu_k, two per form
 };
 
 class QuadraticConstraint final : public Component {
@@ -50,10 +52,10 @@ class QuadraticConstraint final : public Component {
 
  private:
   static std::vector<int> collectDofs(const ConstraintSpec& spec);
-  ConstraintVector positions(const double* z) const;
+  // The constrained positions (shift 0) or their velocities (shift = velocityShift) in z.
+  ConstraintVector gather(const double* z, int shift) const;
+  // lambda_k (0 for penalty).
   double multiplier(const double* z, std::size_t k) const;
-  // Rate form: multiplier rows hold the multipliers (residual 0, diagonal beta).
-  void holdMultipliers(LocalSystem& out, double diagonal) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
 
   ConstraintSpec spec_;

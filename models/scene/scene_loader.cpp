@@ -449,10 +449,11 @@ int SceneCompiler::multipliersOf(const XMLElement& element) const {
   const bool augmented = enforcement ? std::string(enforcement) == "augmented_lagrangian"
                                      : constraintDefaults_.enforcement == Enforcement::AugmentedLagrangian;
   if (!augmented) return 0;
-  if (tag == "body") return 6;
+  // two multipliers per constraint: lambda, and mu of the rate form (GGL)
+  if (tag == "body") return 2 * 6;
   const char* type = element.Attribute("type");
   const std::optional<JointType> joint = type ? jointTypeByName(type) : std::nullopt;
-  return joint ? constraintCount(*joint) : 0;  // a bad type is reported when the joint is read
+  return joint ? 2 * constraintCount(*joint) : 0;  // a bad type is reported when the joint is read
 }
 
 void SceneCompiler::addConstraint(const std::string& name, const JointBuilder& builder,
@@ -465,8 +466,8 @@ void SceneCompiler::addConstraint(const std::string& name, const JointBuilder& b
   spec.stiffness = settings.stiffness;
   if (settings.enforcement == Enforcement::AugmentedLagrangian) {
     spec.firstMultiplierDof = layout_.dof(Block::Multiplier, multiplierCount_);
-    for (std::size_t k = 0; k < forms.size(); ++k) scale_[spec.firstMultiplierDof + k] = 1.0;
-    multiplierCount_ += static_cast<int>(forms.size());
+    for (std::size_t k = 0; k < 2 * forms.size(); ++k) scale_[spec.firstMultiplierDof + k] = 1.0;
+    multiplierCount_ += 2 * static_cast<int>(forms.size());
   }
   spec.forms = std::move(forms);
   components_.push_back(std::make_unique<QuadraticConstraint>(std::move(spec)));
