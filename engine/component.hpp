@@ -12,8 +12,8 @@ namespace mpx {
 using Vec3 = Eigen::Vector3d;
 
 // Largest number of local dofs of one component: a joint between two rigid bodies touches
-// 2 x 12 positions and their 24 velocity rows plus its multipliers.
-inline constexpr int kMaxLocalDofs = 56;
+// 2 x 12 positions, their 24 velocity rows and two multipliers per constraint (up to 6).
+inline constexpr int kMaxLocalDofs = 64;
 
 // Temperature of a thermal node as seen by the heat links that touch it: the discrete
 // temperature theta~ in an EEM step, theta(z) in a rate evaluation. The owner publishes it

@@ -25,6 +25,7 @@ std::optional<JointType> jointTypeByName(const std::string& name) {
   if (name == "prismatic") return JointType::Prismatic;
   if (name == "fixed") return JointType::Fixed;
   if (name == "distance") return JointType::Distance;
+  if (name == "planar") return JointType::Planar;
   return std::nullopt;
 }
 
@@ -37,6 +38,7 @@ int constraintCount(JointType type) {
     case JointType::Prismatic: return 5;
     case JointType::Fixed: return 6;
     case JointType::Distance: return 1;
+    case JointType::Planar: return 3;
   }
   return 0;
 }
@@ -118,9 +120,9 @@ std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeomet
     forms.push_back(dot(direction(0, g.axis), direction(1, n1), 0.0));
     forms.push_back(dot(direction(0, g.axis), direction(1, n2), 0.0));
   };
-  // b's point slides along a's axis only
+  // b's anchor point relative to a's: it slides along a's axis only, or stays in a's plane
+  const AffineVector offset = difference(point(1, g.anchor), point(0, g.anchor));
   auto slideAlongAxis = [&] {
-    const AffineVector offset = difference(point(1, g.anchor), point(0, g.anchor));
     forms.push_back(dot(offset, direction(0, n1), 0.0));
     forms.push_back(dot(offset, direction(0, n2), 0.0));
   };
@@ -141,6 +143,10 @@ std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeomet
       for (int i = 0; i < 3; ++i)
         forms.push_back(dot(direction(0, Vec3::Unit(i)), direction(1, Vec3::Unit((i + 1) % 3)), 0.0));
       break;
+    case JointType::Planar:
+      alignAxis();
+      forms.push_back(dot(offset, direction(0, g.axis), 0.0));
+      break;
     case JointType::Distance: {
       const AffineVector span = difference(point(0, g.anchor), point(1, g.anchorB));
       forms.push_back(dot(span, span, (g.anchor - g.anchorB).squaredNorm()));
@@ -148,6 +154,17 @@ std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeomet
     }
   }
   return forms;
+}
+
+std::vector<QuadraticForm> JointBuilder::coordinateInvariants(JointType type, const JointGeometry& g) const {
+  const auto [n1, n2] = perpendiculars(g.axis);
+  if (type == JointType::Revolute)
+    return {dot(direction(0, n1), direction(1, n1), 0.0), dot(direction(0, n2), direction(1, n1), 0.0)};
+  if (type == JointType::Prismatic) {
+    const AffineVector offset = difference(point(1, g.anchor), point(0, g.anchor));
+    return {dot(offset, direction(0, g.axis), 0.0)};
+  }
+  throw std::invalid_argument("joint forces act on revolute and prismatic joints only");
 }
 
 std::vector<QuadraticForm> JointBuilder::rigidity() const {

@@ -28,15 +28,19 @@ struct AffineVector {
   Vec3 offset = Vec3::Zero();
 };
 
-// Joint kinds and the number of scalar constraints each imposes.
-enum class JointType { Spherical, Revolute, Universal, Cylindrical, Prismatic, Fixed, Distance };
+// Joint kinds and the number of scalar constraints each imposes. A planar joint keeps b's
+// directions perpendicular to a's axis (the plane normal: 2 constraints) and b's anchor point in
+// a's plane through the anchor (1 constraint): b slides in the plane and turns about the normal.
+enum class JointType { Spherical, Revolute, Universal, Cylindrical, Prismatic, Fixed, Distance, Planar };
+inline constexpr const char* kJointTypeNames =
+    "spherical, revolute, universal, cylindrical, prismatic, fixed, distance, planar";
 std::optional<JointType> jointTypeByName(const std::string& name);
 int constraintCount(JointType type);
 
 struct JointGeometry {
   Vec3 anchor = Vec3::Zero();   // joint point (world, t = 0); on b for a distance joint: anchorB
   Vec3 anchorB = Vec3::Zero();  // distance joint: the point on b
-  Vec3 axis = Vec3::UnitZ();    // unit; revolute/cylindrical/prismatic axis, universal axis on a
+  Vec3 axis = Vec3::UnitZ();    // unit; revolute/cylindrical/prismatic axis, planar normal, universal axis on a
   Vec3 axisB = Vec3::UnitX();   // universal: axis on b, perpendicular to axis
 };
 
@@ -50,6 +54,10 @@ class JointBuilder {
   std::vector<QuadraticForm> joint(JointType type, const JointGeometry& geometry) const;
   // d_i . d_j - delta_ij of a single body (b is ignored).
   std::vector<QuadraticForm> rigidity() const;
+  // Quadratic invariants that give a joint's coordinate: revolute (u, v) = (a1.b1, a2.b1) with
+  // a1, a2 perpendicular to the axis on a and b1 on b (angle atan2(v, u), 0 at t = 0);
+  // prismatic s = (p_b - p_a).axis_a - s(0) (0 at t = 0). Throws for other joint types.
+  std::vector<QuadraticForm> coordinateInvariants(JointType type, const JointGeometry& geometry) const;
 
  private:
   AffineVector point(int side, const Vec3& worldPoint) const;

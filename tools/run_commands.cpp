@@ -1,5 +1,6 @@
 // metriplex run and metriplex compare.
 #include "commands.hpp"
+#include "frames_csv.hpp"
 #include "history_csv.hpp"
 
 #include "engine/input_error.hpp"
@@ -22,6 +23,7 @@ struct PreparedRun {
   CompiledScene scene;
   MethodParameters parameters;
   std::filesystem::path out;
+  double frameInterval = 0.0;  // bodies.csv / joints.csv
 };
 
 struct RunResult {
@@ -76,18 +78,24 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   std::filesystem::path out = request.out.empty()
                                   ? std::filesystem::path("out") / (scene.settings.name + "-" + outSuffix)
                                   : std::filesystem::path(request.out);
-  return {*method, std::move(scene), parameters, std::move(out)};
+  checkPositive(request.frameInterval, "--output-interval");
+  return {*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
 }
 
 RunResult execute(const PreparedRun& run) {
   std::filesystem::create_directories(run.out);
   HistoryCsv history(run.out, *run.scene.model);
+  FramesCsv frames(run.out, run.scene, run.frameInterval);
   RunResult result{run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {},
                    history.path()};
   result.summary = runMethod(*run.scene.model, run.method, run.parameters,
-                             [&](const StepRecord& r) { history.write(r); },
+                             [&](const StepRecord& r) {
+                               history.write(r);
+                               frames.write(r);
+                             },
                              progressBar(run.scene.settings.name + " " + run.method.name));
   history.finish(result.summary);
+  frames.finish();
   return result;
 }
 

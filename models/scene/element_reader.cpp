@@ -96,6 +96,25 @@ Vec3 ElementReader::vector(const char* attribute, const Vec3& fallback) {
   return {values[0], values[1], values[2]};
 }
 
+bool ElementReader::flag(const char* attribute, bool fallback) {
+  const std::string value = text(attribute, fallback ? "true" : "false");
+  if (value != "true" && value != "false")
+    fail(std::string("attribute '") + attribute + "' must be 'true' or 'false', got '" + value + "'");
+  return value == "true";
+}
+
+Eigen::Quaterniond ElementReader::orientation(const char* attribute) {
+  if (!has(attribute)) {
+    read_.insert(attribute);
+    return Eigen::Quaterniond::Identity();
+  }
+  const std::vector<double> q = numbers(attribute);
+  if (q.size() != 4) fail(std::string("attribute '") + attribute + "' needs a quaternion: 4 numbers w x y z");
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+  if (!(rotation.norm() > 0.0)) fail(std::string("attribute '") + attribute + "' must not be the zero quaternion");
+  return rotation.normalized();
+}
+
 void ElementReader::finish() const {
   for (const tinyxml2::XMLAttribute* a = element_.FirstAttribute(); a; a = a->Next())
     if (!read_.count(a->Name())) fail(std::string("unknown attribute '") + a->Name() + "'");

@@ -28,6 +28,10 @@ class ElementReader {
   double nonNegative(const char* attribute, double fallback);
   int count(const char* attribute, int fallback);
   Vec3 vector(const char* attribute, const Vec3& fallback);
+  // "true" or "false".
+  bool flag(const char* attribute, bool fallback);
+  // A rotation as a quaternion "w x y z" (normalised); the identity when absent.
+  Eigen::Quaterniond orientation(const char* attribute);
   std::vector<double> numbers(const char* attribute);
 
   // Throw an InputError naming the file, line, element and `message`.

@@ -8,10 +8,13 @@
 #include "models/heat_link.hpp"
 #include "models/inertia.hpp"
 #include "models/joint_builder.hpp"
+#include "models/joint_force.hpp"
+#include "urdf_scene.hpp"
 
 #include <algorithm>
 #include <Eigen/Eigenvalues>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -58,6 +61,7 @@ class SceneCompiler {
   void addForce(ElementReader& in);
   void addBody(ElementReader& in);
   void addJoint(ElementReader& in);
+  void addJointForce(ElementReader& in);
   // Penalty or augmented-Lagrangian enforcement of `forms`, with multipliers when needed.
   void addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
                      const ConstraintSettings& settings);
@@ -90,6 +94,16 @@ class SceneCompiler {
   std::map<std::string, ThermalNodeRef> thermalNodes_;
   std::map<std::string, int> names_;  // every declared name -> line
   std::map<std::string, Attachment> attachments_;  // what joints may attach to
+  // Joints by name, for the force elements on their coordinates.
+  struct DeclaredJoint {
+    JointType type;
+    Attachment a, b;
+    JointGeometry geometry;
+    double coordinate;  // the joint coordinate's value at t = 0 in the user's convention
+  };
+  std::map<std::string, DeclaredJoint> joints_;
+  std::vector<BodyFrame> bodyFrames_;
+  std::vector<JointCoordinate> jointCoordinates_;
   ConstraintSettings constraintDefaults_;
   int positionCount_ = 0, thermalCount_ = 0, internalCount_ = 0, multiplierCount_ = 0;
   double positionScale_ = 0.0;
@@ -127,7 +141,7 @@ CompiledScene SceneCompiler::compile() {
     scale_[v] = std::max(std::abs(state_[v]), length / settings_.tEnd);
   }
   auto model = std::make_unique<Model>(layout_, variable_, std::move(components_), thermalNodeNames_, state_, scale_);
-  return {settings_, std::move(model)};
+  return {settings_, std::move(model), std::move(bodyFrames_), std::move(jointCoordinates_)};
 }
 
 void SceneCompiler::readSettings() {
@@ -207,6 +221,7 @@ void SceneCompiler::addElement(const XMLElement& element) {
   else if (tag == "force") addForce(in);
   else if (tag == "body") addBody(in);
   else if (tag == "joint") addJoint(in);
+  else if (tag == "joint_force") addJointForce(in);
   else in.fail("unknown element (see docs/scene-format.md for the elements a scene may hold)");
   in.finish();
 }
@@ -486,9 +501,7 @@ void SceneCompiler::addBody(ElementReader& in) {
     tensor(0, 2) = tensor(2, 0) = inertia[4];
     tensor(1, 2) = tensor(2, 1) = inertia[5];
   }
-  const std::vector<double> q = in.has("orientation") ? in.numbers("orientation") : std::vector<double>{1, 0, 0, 0};
-  if (q.size() != 4) in.fail("orientation needs a quaternion: 4 numbers w x y z");
-  const Eigen::Quaterniond orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+  const Eigen::Quaterniond orientation = in.orientation("orientation");
   const Vec3 position = in.vector("position", Vec3::Zero());
   const Vec3 velocity = in.vector("velocity", Vec3::Zero());
   const Vec3 angularVelocity = in.vector("angular_velocity", Vec3::Zero());
@@ -517,6 +530,7 @@ void SceneCompiler::addBody(ElementReader& in) {
   keepPositionScale(position.norm());
   points_[name] = Endpoint{phi, phiRate, Vec3::Zero()};
   attachments_[name] = Attachment{Attachment::Kind::Body, phi, position, directors};
+  bodyFrames_.push_back({name, phi, directors.transpose() * rotation});
   components_.push_back(std::make_unique<Inertia>(
       name, phi, phiRate, std::vector<InertiaBlock>{{mass, true}, {E[0], false}, {E[1], false}, {E[2], false}},
       gravity_));
@@ -530,7 +544,7 @@ void SceneCompiler::addJoint(ElementReader& in) {
   const std::optional<JointType> type = jointTypeByName(typeName);
   if (!type)
     in.fail("unknown joint type '" + typeName +
-            "' (choose spherical, revolute, universal, cylindrical, prismatic, fixed, distance)");
+            "' (choose " + kJointTypeNames + ")");
   auto attachment = [&](const char* attribute) {
     const std::string target = in.text(attribute);
     const auto it = attachments_.find(target);
@@ -550,6 +564,7 @@ void SceneCompiler::addJoint(ElementReader& in) {
   geometry.axisB.normalize();
   if (*type == JointType::Distance && !((geometry.anchor - geometry.anchorB).norm() > 0.0))
     in.fail("a distance joint needs anchor and anchor_b apart");
+  const double coordinate = in.number("coordinate", 0.0);
   const ConstraintSettings settings = constraintSettings(in);
   const JointBuilder builder(a, b);
   try {
@@ -557,6 +572,37 @@ void SceneCompiler::addJoint(ElementReader& in) {
   } catch (const std::invalid_argument& e) {
     in.fail(e.what());
   }
+  joints_[name] = DeclaredJoint{*type, a, b, geometry, coordinate};
+  if (*type == JointType::Revolute || *type == JointType::Prismatic)
+    jointCoordinates_.emplace_back(name, *type == JointType::Revolute, builder.positionDofs(),
+                                   layout_.offset(Block::Velocity) - layout_.offset(Block::Position),
+                                   builder.coordinateInvariants(*type, geometry), coordinate);
+}
+
+void SceneCompiler::addJointForce(ElementReader& in) {
+  JointForceSpec spec;
+  spec.name = declareName(in);
+  const std::string jointName = in.text("joint");
+  const auto joint = joints_.find(jointName);
+  if (joint == joints_.end()) in.fail("attribute 'joint': no joint named '" + jointName + "' declared above");
+  if (joint->second.type != JointType::Revolute && joint->second.type != JointType::Prismatic)
+    in.fail("joint '" + jointName + "' is not revolute or prismatic: joint forces act on those coordinates");
+  const JointBuilder builder(joint->second.a, joint->second.b);
+  spec.revolute = joint->second.type == JointType::Revolute;
+  spec.positionDofs = builder.positionDofs();
+  spec.velocityShift = layout_.offset(Block::Velocity) - layout_.offset(Block::Position);
+  spec.invariants = builder.coordinateInvariants(joint->second.type, joint->second.geometry);
+  spec.stiffness = in.nonNegative("stiffness", 0.0);
+  spec.rest = in.number("rest", joint->second.coordinate) - joint->second.coordinate;
+  spec.damping = in.nonNegative("damping", 0.0);
+  spec.friction = in.nonNegative("friction", 0.0);
+  spec.frictionVelocity = in.positive("friction_velocity", 1e-2);
+  if (in.has("heat_node")) {
+    const ThermalNodeRef node = thermalNode(in, "heat_node");
+    if (node.thermalDof < 0) in.fail("heat_node must have a heat capacity (not a fixed temperature)");
+    spec.heatDof = node.thermalDof;
+  }
+  components_.push_back(std::make_unique<JointForce>(std::move(spec)));
 }
 
 CompiledScene compileDocument(tinyxml2::XMLDocument& document, const std::string& label,
@@ -565,12 +611,19 @@ CompiledScene compileDocument(tinyxml2::XMLDocument& document, const std::string
     throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
   const XMLElement* root = document.RootElement();
   if (!root) throw InputError(label, 1, "the file holds no XML element");
+  expandUrdfIncludes(document, label);
   return SceneCompiler(*root, label, thermalVariable).compile();
 }
 
 }  // namespace
 
 CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable) {
+  // a URDF alone is a scene with default settings
+  if (std::filesystem::path(path).extension() == ".urdf") {
+    tinyxml2::XMLDocument document;
+    writeUrdfScene(document, path);
+    return compileDocument(document, path, thermalVariable);
+  }
   std::ifstream file(path);
   if (!file) throw InputError(path + ": cannot open the scene file");
   std::stringstream text;

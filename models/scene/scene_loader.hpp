@@ -3,6 +3,7 @@
 // end time, integrator, solver settings) come back beside the model.
 #include "engine/integrator.hpp"
 #include "engine/model.hpp"
+#include "models/joint_coordinate.hpp"
 #include "models/lumped_element.hpp"
 
 #include <memory>
@@ -21,9 +22,19 @@ struct SceneSettings {
   NewtonSettings newton;
 };
 
+// A rigid body's pose in a state: centre of mass at firstPositionDof, orientation
+// D(t) * directorsToBody with D(t) = [d1 d2 d3] (the body frame as declared in the scene).
+struct BodyFrame {
+  std::string name;
+  int firstPositionDof;
+  Eigen::Matrix3d directorsToBody;
+};
+
 struct CompiledScene {
   SceneSettings settings;
   std::unique_ptr<Model> model;
+  std::vector<BodyFrame> bodies;
+  std::vector<JointCoordinate> joints;  // revolute and prismatic joints, for joints.csv
 };
 
 // Throws InputError (file, line, element, what is wrong) on any invalid input. When

@@ -1,0 +1,382 @@
+#include "urdf_import.hpp"
+
+#include "engine/input_error.hpp"
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+namespace mpx {
+
+namespace {
+
+using Pose = Eigen::Isometry3d;
+
+// URDF damping and friction become <joint_damper> elements once the scene compiler reads them;
+// until then they are reported as ignored.
+constexpr bool kEmitJointDampers = false;
+// Velocity below which an emitted joint damper smooths Coulomb friction (rad/s or m/s).
+constexpr double kFrictionVelocity = 0.01;
+
+Vec3 toEigen(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
+
+Pose toEigen(const urdf::Pose& p) {
+  Pose pose = Pose::Identity();
+  pose.translate(toEigen(p.position));
+  pose.rotate(Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z));
+  return pose;
+}
+
+// Space-separated, with 17 significant digits: the scene reads back exactly these values.
+std::string numbers(std::initializer_list<double> values) {
+  std::string text;
+  for (const double value : values) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    text += (text.empty() ? "" : " ") + std::string(buffer);
+  }
+  return text;
+}
+std::string numbers(const Vec3& v) { return numbers({v.x(), v.y(), v.z()}); }
+
+// 'a', 'b', 'c' for messages.
+std::string quotedList(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+  return list;
+}
+
+void warn(const std::string& path, const std::string& message) {
+  std::cerr << "metriplex: warning: " << path << ": " << message << "\n";
+}
+
+bool hasCoordinate(const urdf::Joint& joint) {
+  return joint.type == urdf::Joint::REVOLUTE || joint.type == urdf::Joint::CONTINUOUS ||
+         joint.type == urdf::Joint::PRISMATIC;
+}
+
+// The scene's joint type for a URDF joint; floating joints have none (the child moves freely).
+const char* sceneJointType(const urdf::Joint& joint) {
+  switch (joint.type) {
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS: return "revolute";
+    case urdf::Joint::PRISMATIC: return "prismatic";
+    case urdf::Joint::PLANAR: return "planar";
+    case urdf::Joint::FIXED: return "fixed";
+    default: return nullptr;
+  }
+}
+
+// The URDF text and the lines of its <link> and <joint> elements: urdfdom keeps no line
+// numbers, so messages find them here.
+class UrdfFile {
+ public:
+  explicit UrdfFile(std::string path) : path_(std::move(path)) {
+    std::ifstream file(path_);
+    if (!file) throw InputError(path_ + ": cannot open the URDF file");
+    std::stringstream text;
+    text << file.rdbuf();
+    text_ = text.str();
+    tinyxml2::XMLDocument document;
+    document.Parse(text_.c_str(), text_.size());
+    if (document.Error())
+      throw InputError(path_, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
+    const tinyxml2::XMLElement* robot = document.RootElement();
+    for (const tinyxml2::XMLElement* e = robot ? robot->FirstChildElement() : nullptr; e; e = e->NextSiblingElement())
+      if (const char* name = e->Attribute("name")) lines_.emplace(key(e->Name(), name), e->GetLineNum());
+  }
+
+  const std::string& path() const { return path_; }
+  const std::string& text() const { return text_; }
+
+  // Throw an InputError at <kind name="name">, kind "link" or "joint".
+  [[noreturn]] void fail(const std::string& kind, const std::string& name, const std::string& message) const {
+    const std::string what = "<" + kind + " name=\"" + name + "\">: " + message;
+    const auto line = lines_.find(key(kind, name));
+    if (line == lines_.end()) throw InputError(path_ + ": " + what);
+    throw InputError(path_, line->second, what);
+  }
+
+ private:
+  static std::string key(const std::string& kind, const std::string& name) { return kind + " " + name; }
+
+  std::string path_, text_;
+  std::map<std::string, int> lines_;
+};
+
+// urdfdom reports problems through console_bridge and may still return a model (a mass it
+// could not parse is left at 0), so while it parses its errors are collected to reject the
+// file and its warnings go to stderr.
+class ParserLog final : public console_bridge::OutputHandler {
+ public:
+  explicit ParserLog(std::string path) : path_(std::move(path)) { console_bridge::useOutputHandler(this); }
+  ~ParserLog() override { console_bridge::restorePreviousOutputHandler(); }
+  ParserLog(const ParserLog&) = delete;
+  ParserLog& operator=(const ParserLog&) = delete;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors_ += (errors_.empty() ? "" : "; ") + text;
+    else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) warn(path_, text);
+  }
+  const std::string& errors() const { return errors_; }
+
+ private:
+  std::string path_, errors_;
+};
+
+urdf::ModelInterfaceSharedPtr parse(const UrdfFile& file) {
+  const ParserLog log(file.path());
+  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(file.text());
+  if (!robot || !log.errors().empty())
+    throw InputError(file.path() + ": invalid URDF: " + (log.errors().empty() ? "urdfdom rejects it" : log.errors()));
+  return robot;
+}
+
+// A link at t = 0 and what carries it in the scene.
+struct LinkState {
+  Pose frame = Pose::Identity();        // world pose of the link frame
+  Vec3 angularVelocity = Vec3::Zero();
+  Vec3 originVelocity = Vec3::Zero();   // velocity of the frame's origin
+  std::string carrier;  // scene name of its body, or of the body or anchor a massless link is merged into
+};
+
+// Walks the tree from the root, parents before children, and emits each link's elements as
+// it reaches them, so every reference is declared above its use.
+class UrdfTranslator {
+ public:
+  UrdfTranslator(const UrdfFile& file, const urdf::ModelInterface& robot, const UrdfImportOptions& options,
+                 tinyxml2::XMLElement& after)
+      : file_(file), robot_(robot), options_(options), last_(&after) {}
+
+  void translate();
+
+ private:
+  void checkInitialStates() const;
+  std::string addRoot(const urdf::Link& root, const LinkState& state);
+  void addChildren(const urdf::Link& parent, const LinkState& parentState);
+  LinkState childState(const urdf::Joint& joint, const LinkState& parent) const;
+  Vec3 unitAxis(const urdf::Joint& joint) const;
+  static bool massless(const urdf::Link& link);
+  void addBody(const urdf::Link& link, const LinkState& state);
+  void checkInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const;
+  void addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child);
+  void addDynamics(const urdf::Joint& joint);
+  void reportIgnored() const;
+  std::string sceneName(const std::string& urdfName) const { return options_.prefix + urdfName; }
+  // A new element named `urdfName` (prefixed) after the previous one.
+  tinyxml2::XMLElement& emit(const char* tag, const std::string& urdfName);
+
+  const UrdfFile& file_;
+  const urdf::ModelInterface& robot_;
+  const UrdfImportOptions& options_;
+  tinyxml2::XMLElement* last_;
+  std::map<std::string, std::string> parentJoint_;  // reached link -> joint it was reached through
+  std::vector<std::string> limitedJoints_, ignoredDynamics_;
+};
+
+void UrdfTranslator::translate() {
+  checkInitialStates();
+  const urdf::Link& root = *robot_.getRoot();
+  LinkState state;
+  state.frame = Eigen::Translation3d(options_.position) * options_.orientation;
+  state.carrier = addRoot(root, state);
+  parentJoint_[root.name] = "";
+  addChildren(root, state);
+  // urdfdom accepts links that a cycle of joints keeps away from the root
+  for (const auto& [name, link] : robot_.links_)
+    if (!parentJoint_.count(name))
+      file_.fail("link", name, "is not connected to the root link '" + root.name + "' (a cycle of joints?)");
+  reportIgnored();
+}
+
+void UrdfTranslator::checkInitialStates() const {
+  for (const auto& [name, state] : options_.initial) {
+    const urdf::JointConstSharedPtr joint = robot_.getJoint(name);
+    if (!joint) throw InputError(file_.path() + ": an initial state is given for joint '" + name + "', which the URDF does not have");
+    if (!hasCoordinate(*joint))
+      file_.fail("joint", name, "takes no initial position or velocity (only revolute, continuous and prismatic joints have one coordinate)");
+  }
+}
+
+std::string UrdfTranslator::addRoot(const urdf::Link& root, const LinkState& state) {
+  const std::string origin = numbers(state.frame.translation());
+  // the world-link idiom: a massless root is the ground itself
+  if (massless(root)) {
+    if (options_.floating) file_.fail("link", root.name, "a floating root link needs an <inertial> with positive mass");
+    emit("anchor", root.name).SetAttribute("position", origin.c_str());
+    return sceneName(root.name);
+  }
+  addBody(root, state);
+  // a root with mass is held by a fixed joint to an anchor at its frame
+  if (!options_.floating) {
+    emit("anchor", root.name + ".ground").SetAttribute("position", origin.c_str());
+    tinyxml2::XMLElement& joint = emit("joint", root.name + ".fixed");
+    joint.SetAttribute("type", "fixed");
+    joint.SetAttribute("a", sceneName(root.name + ".ground").c_str());
+    joint.SetAttribute("b", sceneName(root.name).c_str());
+    joint.SetAttribute("anchor", origin.c_str());
+  }
+  return sceneName(root.name);
+}
+
+void UrdfTranslator::addChildren(const urdf::Link& parent, const LinkState& parentState) {
+  for (const urdf::JointSharedPtr& joint : parent.child_joints) {
+    const urdf::Link& child = *robot_.getLink(joint->child_link_name);
+    const auto [reached, first] = parentJoint_.emplace(child.name, joint->name);
+    if (!first)
+      file_.fail("link", child.name, "is the child of two joints, '" + reached->second + "' and '" + joint->name +
+                                         "': a URDF must be a tree");
+    if (joint->mimic)
+      file_.fail("joint", joint->name, "mimics joint '" + joint->mimic->joint_name +
+                                           "': mimic joints are not supported (import it as an independent joint)");
+    LinkState state = childState(*joint, parentState);
+    if (massless(child)) {
+      // a massless link rigidly fixed to its parent is merged into the parent's carrier
+      if (joint->type != urdf::Joint::FIXED)
+        file_.fail("link", child.name, "has no mass (no <inertial>, or mass and inertia 0) but joint '" + joint->name +
+                                           "' moves it: give it a positive mass or fix it to its parent");
+      state.carrier = parentState.carrier;
+    } else {
+      addBody(child, state);
+      state.carrier = sceneName(child.name);
+      if (joint->type != urdf::Joint::FLOATING) addJoint(*joint, parentState, state);
+    }
+    addDynamics(*joint);
+    addChildren(child, state);
+  }
+}
+
+LinkState UrdfTranslator::childState(const urdf::Joint& joint, const LinkState& parent) const {
+  const auto initial = options_.initial.find(joint.name);
+  const UrdfJointState q = initial == options_.initial.end() ? UrdfJointState{} : initial->second;
+  LinkState child;
+  child.frame = parent.frame * toEigen(joint.parent_to_joint_origin_transform);
+  if (!child.frame.matrix().allFinite()) file_.fail("joint", joint.name, "the <origin> must be finite");
+  // the joint's own motion: its axis stays put in world coordinates while the child moves along it
+  Vec3 worldAxis = Vec3::Zero(), spin = Vec3::Zero(), slide = Vec3::Zero();
+  if (hasCoordinate(joint)) {
+    const Vec3 axis = unitAxis(joint);
+    worldAxis = child.frame.linear() * axis;
+    if (joint.type == urdf::Joint::PRISMATIC) {
+      child.frame.translate(q.position * axis);
+      slide = q.velocity * worldAxis;
+    } else {
+      child.frame.rotate(Eigen::AngleAxisd(q.position, axis));
+      spin = q.velocity * worldAxis;
+    }
+  }
+  // rigid motion with the parent plus the joint rate
+  child.angularVelocity = parent.angularVelocity + spin;
+  child.originVelocity = parent.originVelocity +
+                         parent.angularVelocity.cross(child.frame.translation() - parent.frame.translation()) + slide;
+  return child;
+}
+
+Vec3 UrdfTranslator::unitAxis(const urdf::Joint& joint) const {
+  const Vec3 axis = toEigen(joint.axis);
+  if (!axis.allFinite() || !(axis.norm() > 0.0)) file_.fail("joint", joint.name, "the <axis> must be a non-zero vector");
+  return axis.normalized();
+}
+
+bool UrdfTranslator::massless(const urdf::Link& link) {
+  if (!link.inertial) return true;
+  const urdf::Inertial& i = *link.inertial;
+  return i.mass == 0.0 && i.ixx == 0.0 && i.iyy == 0.0 && i.izz == 0.0 && i.ixy == 0.0 && i.ixz == 0.0 && i.iyz == 0.0;
+}
+
+void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
+  const urdf::Inertial& inertial = *link.inertial;
+  Eigen::Matrix3d tensor;
+  tensor << inertial.ixx, inertial.ixy, inertial.ixz, inertial.ixy, inertial.iyy, inertial.iyz, inertial.ixz,
+      inertial.iyz, inertial.izz;
+  if (!(inertial.mass > 0.0) || !std::isfinite(inertial.mass))
+    file_.fail("link", link.name, "mass must be positive and finite, got " + numbers({inertial.mass}));
+  checkInertia(link, tensor);
+  // the tensor is given about the centre of mass in the inertial frame: the body's orientation
+  const Pose inertialFrame = state.frame * toEigen(inertial.origin);
+  const Vec3 centre = inertialFrame.translation();
+  const Eigen::Quaterniond orientation(inertialFrame.linear());
+  const Vec3 velocity = state.originVelocity + state.angularVelocity.cross(centre - state.frame.translation());
+  tinyxml2::XMLElement& body = emit("body", link.name);
+  body.SetAttribute("mass", inertial.mass);
+  body.SetAttribute("inertia", numbers({inertial.ixx, inertial.iyy, inertial.izz, inertial.ixy, inertial.ixz, inertial.iyz}).c_str());
+  body.SetAttribute("position", numbers(centre).c_str());
+  body.SetAttribute("orientation", numbers({orientation.w(), orientation.x(), orientation.y(), orientation.z()}).c_str());
+  body.SetAttribute("velocity", numbers(velocity).c_str());
+  body.SetAttribute("angular_velocity", numbers(state.angularVelocity).c_str());
+}
+
+// A director body's "masses" (J_j + J_k - J_i)/2 must be positive: principal moments need the
+// strict triangle inequality (no regularisation: a degenerate tensor is rejected).
+void UrdfTranslator::checkInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const {
+  if (!tensor.allFinite()) file_.fail("link", link.name, "the inertia must be finite");
+  const Vec3 J = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor, Eigen::EigenvaluesOnly).eigenvalues();
+  if (!(J[0] > 0.0))
+    file_.fail("link", link.name, "the inertia tensor must be positive definite; its principal moments are " + numbers(J));
+  if (!(J[0] + J[1] > J[2]))
+    file_.fail("link", link.name, "the principal moments " + numbers(J) +
+                                      " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need");
+}
+
+void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child) {
+  tinyxml2::XMLElement& element = emit("joint", joint.name);
+  element.SetAttribute("type", sceneJointType(joint));
+  element.SetAttribute("a", parent.carrier.c_str());
+  element.SetAttribute("b", child.carrier.c_str());
+  element.SetAttribute("anchor", numbers(child.frame.translation()).c_str());
+  if (joint.type != urdf::Joint::FIXED)
+    element.SetAttribute("axis", numbers(child.frame.linear() * unitAxis(joint)).c_str());
+}
+
+void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
+  if ((joint.type == urdf::Joint::REVOLUTE || joint.type == urdf::Joint::PRISMATIC) && joint.limits &&
+      joint.limits->lower < joint.limits->upper)
+    limitedJoints_.push_back(joint.name);
+  if (!joint.dynamics || (joint.dynamics->damping == 0.0 && joint.dynamics->friction == 0.0)) return;
+  if (!(joint.dynamics->damping >= 0.0 && joint.dynamics->friction >= 0.0) || !std::isfinite(joint.dynamics->damping) ||
+      !std::isfinite(joint.dynamics->friction))
+    file_.fail("joint", joint.name, "damping and friction must be finite and not negative");
+  if (!kEmitJointDampers || !hasCoordinate(joint)) {
+    ignoredDynamics_.push_back(joint.name);
+    return;
+  }
+  tinyxml2::XMLElement& damper = emit("joint_damper", joint.name + ".damping");
+  damper.SetAttribute("joint", sceneName(joint.name).c_str());
+  damper.SetAttribute("damping", joint.dynamics->damping);
+  damper.SetAttribute("friction", joint.dynamics->friction);
+  damper.SetAttribute("friction_velocity", kFrictionVelocity);
+}
+
+void UrdfTranslator::reportIgnored() const {
+  if (!limitedJoints_.empty())
+    warn(file_.path(), "position limits of joints " + quotedList(limitedJoints_) + " are ignored (no joint stops)");
+  if (!ignoredDynamics_.empty())
+    warn(file_.path(), "damping and friction of joints " + quotedList(ignoredDynamics_) +
+                           " are ignored (joint dampers act on revolute, continuous and prismatic joints only)");
+}
+
+tinyxml2::XMLElement& UrdfTranslator::emit(const char* tag, const std::string& urdfName) {
+  tinyxml2::XMLElement* element = last_->GetDocument()->NewElement(tag);
+  element->SetAttribute("name", sceneName(urdfName).c_str());
+  last_->Parent()->InsertAfterChild(last_, element);
+  last_ = element;
+  return *element;
+}
+
+}  // namespace
+
+void insertUrdfElements(const std::string& path, const UrdfImportOptions& options, tinyxml2::XMLElement& after) {
+  const UrdfFile file(path);
+  const urdf::ModelInterfaceSharedPtr robot = parse(file);
+  UrdfTranslator(file, *robot, options, after).translate();
+}
+
+}  // namespace mpx

@@ -1,0 +1,35 @@
+#pragma once
+// URDF front end of the scene format (docs/scene-format.md, "URDF robots"): a robot read with
+// urdfdom becomes the scene elements that describe it, in world coordinates at the initial
+// configuration: an <anchor> for the ground, a <body> per link with mass, a <joint> per moving
+// or fixed URDF joint and a joint damper per joint with <dynamics>. The scene compiler then
+// reads them like hand-written elements.
+#include "engine/component.hpp"
+
+#include <tinyxml2.h>
+
+#include <map>
+#include <string>
+
+namespace mpx {
+
+// Initial coordinate and rate of a revolute, continuous or prismatic joint (rad or m, per s).
+struct UrdfJointState {
+  double position = 0.0;
+  double velocity = 0.0;
+};
+
+struct UrdfImportOptions {
+  bool floating = false;  // the root link moves freely instead of being fixed to the ground
+  Vec3 position = Vec3::Zero();  // world pose of the root link's frame
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  std::map<std::string, UrdfJointState> initial;  // by URDF joint name; the others start at 0, at rest
+  std::string prefix;  // put before every element name, so a robot can be included twice
+};
+
+// Validate the URDF at `path` and insert its scene elements after `after`, in an order the
+// compiler accepts (every reference declared above its use). Throws InputError naming the
+// URDF file and, where there is one, the line of the offending <link> or <joint>.
+void insertUrdfElements(const std::string& path, const UrdfImportOptions& options, tinyxml2::XMLElement& after);
+
+}  // namespace mpx
