@@ -144,7 +144,8 @@ std::string schemeName(Scheme scheme) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,
-                         testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml"),
+                         testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
+                                                          "damped_double_pendulum.xml"),
                                           testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal)),
                          [](const testing::TestParamInfo<StepLoopAllocation::ParamType>& info) {
                            std::string scene = std::get<0>(info.param);

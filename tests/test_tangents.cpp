@@ -82,6 +82,25 @@ std::string thermoMaxwellChain(ThermalVariable variable) {
     <heat_link name="spring_out" a="environment" b="spring" conductivity="0.3"/>)";
 }
 
+// Two rigid bodies on a revolute hinge (augmented Lagrangian) and a prismatic slider
+// (penalty), with a torsional spring, damping and friction heating a reservoir, and a
+// linear spring-damper on the slider dissipating without a thermal node.
+std::string dissipativeJoints(ThermalVariable) {
+  return R"(<gravity g="0 0 -9.81"/>
+    <anchor name="ground" position="0 0 0"/>
+    <body name="arm" mass="1" inertia="0.01 0.09 0.09" position="0.5 0 0" angular_velocity="0 0.7 0"/>
+    <body name="slider" mass="0.5" inertia="0.02 0.03 0.04" position="1.2 0 0.1" velocity="0.2 0 -0.35"
+          angular_velocity="0 0.7 0"/>
+    <joint name="hinge" type="revolute" a="ground" b="arm" anchor="0 0 0" axis="0 1 0"/>
+    <joint name="slide" type="prismatic" a="arm" b="slider" anchor="1.2 0 0.1" axis="1 0 0"
+           enforcement="penalty" stiffness="1e4"/>
+    <reservoir name="bearing" heat_capacity="2" reference_temperature="1" temperature="1.1"/>
+    <joint_force name="hinge_losses" joint="hinge" stiffness="3" rest="0.2" damping="0.4" friction="0.1"
+                 friction_velocity="0.5" heat_node="bearing"/>
+    <joint_force name="slide_spring" joint="slide" stiffness="20" rest="0.05" damping="0.3" friction="0.2"
+                 friction_velocity="0.3"/>)";
+}
+
 struct SceneBody {
   const char* name;
   std::string (*body)(ThermalVariable);
@@ -90,7 +109,8 @@ struct SceneBody {
 const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity},
                              {"maxwell_with_dampers", maxwellWithDampers},
                              {"thermo_spring_to_wall", thermoSpringToWall},
-                             {"thermo_maxwell_chain", thermoMaxwellChain}};
+                             {"thermo_maxwell_chain", thermoMaxwellChain},
+                             {"dissipative_joints", dissipativeJoints}};
 
 std::string variableName(ThermalVariable variable) {
   return variable == ThermalVariable::Temperature ? "temperature" : "entropy";
