@@ -83,8 +83,9 @@ std::string thermoMaxwellChain(ThermalVariable variable) {
 }
 
 // Two rigid bodies on a revolute hinge (augmented Lagrangian) and a prismatic slider
-// (penalty), with a torsional spring, damping and friction heating a reservoir, and a
-// linear spring-damper on the slider dissipating without a thermal node.
+// (penalty), with a torsional spring, a Maxwell branch, damping and friction heating a
+// reservoir, and a nonlinear spring, a Maxwell branch and a damper on the slider dissipating
+// without a thermal node.
 std::string dissipativeJoints(ThermalVariable) {
   return R"(<gravity g="0 0 -9.81"/>
     <anchor name="ground" position="0 0 0"/>
@@ -96,9 +97,9 @@ std::string dissipativeJoints(ThermalVariable) {
            enforcement="penalty" stiffness="1e4"/>
     <reservoir name="bearing" heat_capacity="2" reference_temperature="1" temperature="1.1"/>
     <joint_force name="hinge_losses" joint="hinge" stiffness="3" rest="0.2" damping="0.4" friction="0.1"
-                 friction_velocity="0.5" heat_node="bearing"/>
-    <joint_force name="slide_spring" joint="slide" stiffness="20" rest="0.05" damping="0.3" friction="0.2"
-                 friction_velocity="0.3"/>)";
+                 friction_velocity="0.5" branch_stiffness="2" viscosity="0.6" heat_node="bearing"/>
+    <joint_force name="slide_spring" joint="slide" stiffness="20" rest="0.05" cubic_stiffness="50" damping="0.3"
+                 friction="0.2" friction_velocity="0.3" branch_stiffness="8" viscosity="0.4"/>)";
 }
 
 struct SceneBody {

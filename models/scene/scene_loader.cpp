@@ -30,7 +30,11 @@ using tinyxml2::XMLElement;
 bool ownsThermalDof(const std::string& tag) {
   return tag == "thermo_spring" || tag == "thermo_maxwell" || tag == "reservoir";
 }
-bool ownsInternalDof(const std::string& tag) { return tag == "maxwell" || tag == "thermo_maxwell"; }
+bool ownsInternalDof(const XMLElement& element) {
+  const std::string tag = element.Name();
+  return tag == "maxwell" || tag == "thermo_maxwell" ||
+         (tag == "joint_force" && element.Attribute("branch_stiffness") != nullptr);
+}
 
 // How a set of constraints is enforced.
 struct ConstraintSettings {
@@ -121,7 +125,7 @@ CompiledScene SceneCompiler::compile() {
     const std::string tag = e->Name();
     positions += tag == "mass" ? 3 : tag == "body" ? 12 : 0;
     thermal += ownsThermalDof(tag);
-    internal += ownsInternalDof(tag);
+    internal += ownsInternalDof(*e);
     multipliers += multipliersOf(*e);
   }
   layout_ = Layout({positions, positions, thermal, internal, multipliers});
@@ -594,6 +598,14 @@ void SceneCompiler::addJointForce(ElementReader& in) {
   spec.invariants = builder.coordinateInvariants(joint->second.type, joint->second.geometry);
   spec.stiffness = in.nonNegative("stiffness", 0.0);
   spec.rest = in.number("rest", joint->second.coordinate) - joint->second.coordinate;
+  spec.cubicStiffness = in.nonNegative("cubic_stiffness", 0.0);
+  if (spec.revolute && spec.cubicStiffness > 0.0) in.fail("cubic_stiffness applies to prismatic joints only");
+  if (in.has("branch_stiffness")) {
+    spec.branchStiffness = in.positive("branch_stiffness");
+    spec.viscosity = in.positive("viscosity");
+    spec.internalDof = layout_.dof(Block::Internal, internalCount_++);
+    scale_[spec.internalDof] = 1.0;
+  }
   spec.damping = in.nonNegative("damping", 0.0);
   spec.friction = in.nonNegative("friction", 0.0);
   spec.frictionVelocity = in.positive("friction_velocity", 1e-2);
