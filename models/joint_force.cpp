@@ -59,7 +59,7 @@ Vec3 JointForce::arguments(const double* z) const {
   return args;
 }
 
-ArgumentJacobian JointForce::invariantJacobian(const ConstraintVector& q) const {
+JointForce::ArgumentJacobian JointForce::invariantJacobian(const ConstraintVector& q) const {
   ArgumentJacobian jacobian = ArgumentJacobian::Zero(3, n_);
   for (std::size_t a = 0; a < spec_.invariants.size(); ++a)
     jacobian.row(a) = spec_.invariants[a].gradientAt(q).transpose();

@@ -177,8 +177,8 @@ int benchCommand(const BenchRequest& request) {
   const std::string sceneText = readFile(request.scene);
   std::map<std::string, CompiledScene> scenes;  // per method name: its thermal variable
   for (const Method& method : methods)
-    scenes.emplace(method.name, loadSceneText(sceneText, request.scene, method.thermalVariable));
-  const CompiledScene own = loadSceneText(sceneText, request.scene);
+    scenes.emplace(method.name, loadScene(request.scene, method.thermalVariable));
+  const CompiledScene own = loadScene(request.scene);
   const SceneSettings& settings = own.settings;
   const double tEnd = request.tEnd.value_or(settings.tEnd);
   std::vector<double> steps = request.steps;

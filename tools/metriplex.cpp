@@ -23,7 +23,7 @@ std::vector<std::string> splitNames(const std::string& list) {
 
 // Options every subcommand shares.
 void addSceneOptions(CLI::App* command, RunRequest& request) {
-  command->add_option("SCENE", request.scene, "scene file (XML, see docs/scene-format.md)")->required();
+  command->add_option("SCENE", request.scene, "scene file (XML) or a robot's .urdf, see docs/scene-format.md")->required();
   command->add_option("--t-end", request.tEnd, "end time (default: the scene's simulation t_end)");
 }
 

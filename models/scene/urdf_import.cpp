@@ -20,10 +20,7 @@ namespace {
 
 using Pose = Eigen::Isometry3d;
 
-// URDF damping and friction become <joint_damper> elements once the scene compiler reads them;
-// until then they are reported as ignored.
-constexpr bool kEmitJointDampers = false;
-// Velocity below which an emitted joint damper smooths Coulomb friction (rad/s or m/s).
+// Velocity below which the joint force of a URDF <dynamics> smooths Coulomb friction (rad/s or m/s).
 constexpr double kFrictionVelocity = 0.01;
 
 Vec3 toEigen(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
@@ -159,10 +156,12 @@ class UrdfTranslator {
   void translate();
 
  private:
-  void checkInitialStates() const;
+  // Joint names must not be link names; initial states must name joints with a coordinate.
+  void checkNames() const;
   std::string addRoot(const urdf::Link& root, const LinkState& state);
   void addChildren(const urdf::Link& parent, const LinkState& parentState);
   LinkState childState(const urdf::Joint& joint, const LinkState& parent) const;
+  UrdfJointState initialState(const urdf::Joint& joint) const;
   Vec3 unitAxis(const urdf::Joint& joint) const;
   static bool massless(const urdf::Link& link);
   void addBody(const urdf::Link& link, const LinkState& state);
@@ -183,7 +182,7 @@ class UrdfTranslator {
 };
 
 void UrdfTranslator::translate() {
-  checkInitialStates();
+  checkNames();
   const urdf::Link& root = *robot_.getRoot();
   LinkState state;
   state.frame = Eigen::Translation3d(options_.position) * options_.orientation;
@@ -197,12 +196,19 @@ void UrdfTranslator::translate() {
   reportIgnored();
 }
 
-void UrdfTranslator::checkInitialStates() const {
+void UrdfTranslator::checkNames() const {
+  // a scene name belongs to one element, but URDF links and joints have separate name spaces
+  for (const auto& [name, joint] : robot_.joints_)
+    if (robot_.links_.count(name))
+      file_.fail("joint", name, "has the name of a link, and scene names must be unique: rename one of them");
   for (const auto& [name, state] : options_.initial) {
     const urdf::JointConstSharedPtr joint = robot_.getJoint(name);
-    if (!joint) throw InputError(file_.path() + ": an initial state is given for joint '" + name + "', which the URDF does not have");
+    if (!joint)
+      throw InputError(file_.path() + ": an initial state is given for joint '" + name +
+                       "', which the URDF does not have");
     if (!hasCoordinate(*joint))
-      file_.fail("joint", name, "takes no initial position or velocity (only revolute, continuous and prismatic joints have one coordinate)");
+      file_.fail("joint", name, "takes no initial position or velocity (only revolute, continuous and prismatic "
+                                "joints have one coordinate)");
   }
 }
 
@@ -255,8 +261,7 @@ void UrdfTranslator::addChildren(const urdf::Link& parent, const LinkState& pare
 }
 
 LinkState UrdfTranslator::childState(const urdf::Joint& joint, const LinkState& parent) const {
-  const auto initial = options_.initial.find(joint.name);
-  const UrdfJointState q = initial == options_.initial.end() ? UrdfJointState{} : initial->second;
+  const UrdfJointState q = initialState(joint);
   LinkState child;
   child.frame = parent.frame * toEigen(joint.parent_to_joint_origin_transform);
   if (!child.frame.matrix().allFinite()) file_.fail("joint", joint.name, "the <origin> must be finite");
@@ -280,9 +285,15 @@ LinkState UrdfTranslator::childState(const urdf::Joint& joint, const LinkState& 
   return child;
 }
 
+UrdfJointState UrdfTranslator::initialState(const urdf::Joint& joint) const {
+  const auto initial = options_.initial.find(joint.name);
+  return initial == options_.initial.end() ? UrdfJointState{} : initial->second;
+}
+
 Vec3 UrdfTranslator::unitAxis(const urdf::Joint& joint) const {
   const Vec3 axis = toEigen(joint.axis);
-  if (!axis.allFinite() || !(axis.norm() > 0.0)) file_.fail("joint", joint.name, "the <axis> must be a non-zero vector");
+  if (!axis.allFinite() || !(axis.norm() > 0.0))
+    file_.fail("joint", joint.name, "the <axis> must be a non-zero vector");
   return axis.normalized();
 }
 
@@ -293,23 +304,22 @@ bool UrdfTranslator::massless(const urdf::Link& link) {
 }
 
 void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
-  const urdf::Inertial& inertial = *link.inertial;
+  const urdf::Inertial& i = *link.inertial;
+  if (!(i.mass > 0.0) || !std::isfinite(i.mass))
+    file_.fail("link", link.name, "mass must be positive and finite, got " + numbers({i.mass}));
   Eigen::Matrix3d tensor;
-  tensor << inertial.ixx, inertial.ixy, inertial.ixz, inertial.ixy, inertial.iyy, inertial.iyz, inertial.ixz,
-      inertial.iyz, inertial.izz;
-  if (!(inertial.mass > 0.0) || !std::isfinite(inertial.mass))
-    file_.fail("link", link.name, "mass must be positive and finite, got " + numbers({inertial.mass}));
+  tensor << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
   checkInertia(link, tensor);
   // the tensor is given about the centre of mass in the inertial frame: the body's orientation
-  const Pose inertialFrame = state.frame * toEigen(inertial.origin);
+  const Pose inertialFrame = state.frame * toEigen(i.origin);
   const Vec3 centre = inertialFrame.translation();
-  const Eigen::Quaterniond orientation(inertialFrame.linear());
+  const Eigen::Quaterniond q(inertialFrame.linear());
   const Vec3 velocity = state.originVelocity + state.angularVelocity.cross(centre - state.frame.translation());
   tinyxml2::XMLElement& body = emit("body", link.name);
-  body.SetAttribute("mass", inertial.mass);
-  body.SetAttribute("inertia", numbers({inertial.ixx, inertial.iyy, inertial.izz, inertial.ixy, inertial.ixz, inertial.iyz}).c_str());
+  body.SetAttribute("mass", i.mass);
+  body.SetAttribute("inertia", numbers({i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz}).c_str());
   body.SetAttribute("position", numbers(centre).c_str());
-  body.SetAttribute("orientation", numbers({orientation.w(), orientation.x(), orientation.y(), orientation.z()}).c_str());
+  body.SetAttribute("orientation", numbers({q.w(), q.x(), q.y(), q.z()}).c_str());
   body.SetAttribute("velocity", numbers(velocity).c_str());
   body.SetAttribute("angular_velocity", numbers(state.angularVelocity).c_str());
 }
@@ -320,7 +330,8 @@ void UrdfTranslator::checkInertia(const urdf::Link& link, const Eigen::Matrix3d&
   if (!tensor.allFinite()) file_.fail("link", link.name, "the inertia must be finite");
   const Vec3 J = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor, Eigen::EigenvaluesOnly).eigenvalues();
   if (!(J[0] > 0.0))
-    file_.fail("link", link.name, "the inertia tensor must be positive definite; its principal moments are " + numbers(J));
+    file_.fail("link", link.name,
+               "the inertia tensor must be positive definite; its principal moments are " + numbers(J));
   if (!(J[0] + J[1] > J[2]))
     file_.fail("link", link.name, "the principal moments " + numbers(J) +
                                       " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need");
@@ -334,6 +345,8 @@ void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent,
   element.SetAttribute("anchor", numbers(child.frame.translation()).c_str());
   if (joint.type != urdf::Joint::FIXED)
     element.SetAttribute("axis", numbers(child.frame.linear() * unitAxis(joint)).c_str());
+  // joints.csv then reports the URDF's own joint coordinate
+  if (hasCoordinate(joint)) element.SetAttribute("coordinate", initialState(joint).position);
 }
 
 void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
@@ -344,11 +357,11 @@ void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
   if (!(joint.dynamics->damping >= 0.0 && joint.dynamics->friction >= 0.0) || !std::isfinite(joint.dynamics->damping) ||
       !std::isfinite(joint.dynamics->friction))
     file_.fail("joint", joint.name, "damping and friction must be finite and not negative");
-  if (!kEmitJointDampers || !hasCoordinate(joint)) {
+  if (!hasCoordinate(joint)) {
     ignoredDynamics_.push_back(joint.name);
     return;
   }
-  tinyxml2::XMLElement& damper = emit("joint_damper", joint.name + ".damping");
+  tinyxml2::XMLElement& damper = emit("joint_force", joint.name + ".damping");
   damper.SetAttribute("joint", sceneName(joint.name).c_str());
   damper.SetAttribute("damping", joint.dynamics->damping);
   damper.SetAttribute("friction", joint.dynamics->friction);
@@ -360,7 +373,7 @@ void UrdfTranslator::reportIgnored() const {
     warn(file_.path(), "position limits of joints " + quotedList(limitedJoints_) + " are ignored (no joint stops)");
   if (!ignoredDynamics_.empty())
     warn(file_.path(), "damping and friction of joints " + quotedList(ignoredDynamics_) +
-                           " are ignored (joint dampers act on revolute, continuous and prismatic joints only)");
+                           " are ignored (joint forces act on revolute, continuous and prismatic joints only)");
 }
 
 tinyxml2::XMLElement& UrdfTranslator::emit(const char* tag, const std::string& urdfName) {

@@ -29,7 +29,8 @@ UrdfImportOptions readOptions(ElementReader& in, const XMLElement& include) {
     if (std::string(child->Name()) != "initial") initial.fail("a <urdf> element holds <initial> elements only");
     const std::string joint = initial.text("joint");
     const UrdfJointState state{initial.number("position", 0.0), initial.number("velocity", 0.0)};
-    if (!options.initial.emplace(joint, state).second) initial.fail("joint '" + joint + "' has an initial state already");
+    if (!options.initial.emplace(joint, state).second)
+      initial.fail("joint '" + joint + "' has an initial state already");
     initial.finish();
   }
   return options;
