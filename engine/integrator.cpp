@@ -20,6 +20,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       zDot_(model.layout().total()),
       increment_(model.layout().total()),
       trial_(model.layout().total()),
+      unknownsWithScale_(model.layout().offset(Block::Multiplier)),
       halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())) {}
 
 Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
@@ -92,7 +93,10 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     }
     zNew.swap(trial_);
     ++outcome.iterations;
-    incrementNorm = step * (increment_.array().abs() / (zNew.array().abs() + scale.array())).maxCoeff();
+    // multipliers have no natural scale; their rows' residual (the constraints) judges them
+    incrementNorm = step * (increment_.head(unknownsWithScale_).array().abs() /
+                            (zNew.head(unknownsWithScale_).array().abs() + scale.head(unknownsWithScale_).array()))
+                               .maxCoeff();
     residualNorm = rescaledNorm(system);
   }
 }

@@ -64,6 +64,7 @@ class Integrator {
   KluSolver solver_;
   Workspace workspace_;
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
+  int unknownsWithScale_;  // dofs before the multiplier block: those in the increment test
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
 };
 
