@@ -4,6 +4,7 @@
 #include "engine/method.hpp"
 #include "models/damper.hpp"
 #include "models/external_force.hpp"
+#include "models/external_torque.hpp"
 #include "models/fixed_temperature.hpp"
 #include "models/heat_link.hpp"
 #include "models/inertia.hpp"
@@ -63,6 +64,7 @@ class SceneCompiler {
   void addFixedTemperature(ElementReader& in);
   void addHeatLink(ElementReader& in);
   void addForce(ElementReader& in);
+  void addTorque(ElementReader& in);
   void addBody(ElementReader& in);
   void addJoint(ElementReader& in);
   void addJointForce(ElementReader& in);
@@ -223,6 +225,7 @@ void SceneCompiler::addElement(const XMLElement& element) {
   else if (tag == "fixed_temperature") addFixedTemperature(in);
   else if (tag == "heat_link") addHeatLink(in);
   else if (tag == "force") addForce(in);
+  else if (tag == "torque") addTorque(in);
   else if (tag == "body") addBody(in);
   else if (tag == "joint") addJoint(in);
   else if (tag == "joint_force") addJointForce(in);
@@ -423,32 +426,45 @@ void SceneCompiler::addHeatLink(ElementReader& in) {
   components_.push_back(std::make_unique<HeatLink>(name, std::move(a), std::move(b), in.positive("conductivity")));
 }
 
-void SceneCompiler::addForce(ElementReader& in) {
-  const std::string name = declareName(in);
-  const Endpoint on = endpoint(in, "on");
-  if (!on.isMass()) in.fail("attribute 'on' must name a mass, not an anchor");
-  const Vec3 force = in.vector("force", Vec3::Zero());
+// The time function of a load: profile="constant|ramp|hat|table" and its parameters.
+TimeFunction readProfile(ElementReader& in) {
   const std::string profile = in.text("profile", "constant");
-  TimeFunction f;
-  if (profile == "constant") {
-    f = TimeFunction::constant();
-  } else if (profile == "ramp") {
+  if (profile == "constant") return TimeFunction::constant();
+  if (profile == "ramp") {
     const double start = in.nonNegative("start", 0.0), end = in.positive("end");
     if (!(end > start)) in.fail("ramp needs end > start");
-    f = TimeFunction::ramp(start, end);
-  } else if (profile == "hat") {
-    f = TimeFunction::hat(in.positive("period"));
-  } else if (profile == "table") {
+    return TimeFunction::ramp(start, end);
+  }
+  if (profile == "hat") return TimeFunction::hat(in.positive("period"));
+  if (profile == "table") {
     std::vector<double> times = in.numbers("times"), values = in.numbers("values");
     if (times.empty() || times.size() != values.size()) in.fail("'times' and 'values' need the same, non-zero count");
     if (!std::is_sorted(times.begin(), times.end(), std::less_equal<>()) ||
         std::adjacent_find(times.begin(), times.end()) != times.end())
       in.fail("'times' must be strictly increasing");
-    f = TimeFunction::table(std::move(times), std::move(values));
-  } else {
-    in.fail("profile must be constant, ramp, hat or table, got '" + profile + "'");
+    return TimeFunction::table(std::move(times), std::move(values));
   }
-  components_.push_back(std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, std::move(f)));
+  in.fail("profile must be constant, ramp, hat or table, got '" + profile + "'");
+}
+
+void SceneCompiler::addForce(ElementReader& in) {
+  const std::string name = declareName(in);
+  const Endpoint on = endpoint(in, "on");
+  if (!on.isMass()) in.fail("attribute 'on' must name a mass or a body (its centre of mass), not an anchor");
+  const Vec3 force = in.vector("force", Vec3::Zero());
+  components_.push_back(std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, readProfile(in)));
+}
+
+void SceneCompiler::addTorque(ElementReader& in) {
+  const std::string name = declareName(in);
+  const std::string target = in.text("on");
+  const auto body = attachments_.find(target);
+  if (body == attachments_.end() || body->second.kind != Attachment::Kind::Body)
+    in.fail("attribute 'on': no body named '" + target + "' declared above this element");
+  const Vec3 torque = in.vector("torque", Vec3::Zero());
+  components_.push_back(std::make_unique<ExternalTorque>(
+      name, body->second.firstPositionDof + 3, layout_.offset(Block::Velocity) - layout_.offset(Block::Position), torque,
+      readProfile(in)));
 }
 
 ConstraintSettings SceneCompiler::constraintSettings(ElementReader& in) {
