@@ -73,23 +73,21 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     }
     if (iteration == settings_.maxIterations)
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
-    if (!solver_.factorize(system.tangent())) return fail("singular tangent", iteration, incrementNorm, residualNorm);
-    increment_ = -system.residual();
-    solver_.solve(increment_);
-
     // backtrack along the Newton direction until the residual is finite and decreases (a
-    // full step near the solution, where the residual is already at round-off level)
+    // full step near the solution, where the residual is already at round-off level); if no
+    // step decreases it, the reused pivots may be to blame: pivot afresh once
     double step = 1.0;
-    for (;;) {
-      trial_ = zNew + step * increment_;
-      evaluate(zOld, trial_, t, dt);
-      const double trialNorm = system.relativeResidualNorm();
-      if (trialNorm <= (1.0 - 1e-4 * step) * residualNorm ||
-          (std::isfinite(trialNorm) && residualNorm <= settings_.residualTolerance))
-        break;
-      step *= 0.5;
-      if (step < kSmallestLineSearchStep)
+    for (bool repivot = false;;) {
+      if (!solver_.factorize(system.tangent(), repivot))
+        return fail("singular tangent", iteration, incrementNorm, residualNorm);
+      increment_ = -system.residual();
+      solver_.solve(increment_);
+      step = lineSearch(zOld, t, dt, zNew, residualNorm);
+      if (step > 0.0) break;
+      if (repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
+      repivot = true;
+      evaluate(zOld, zNew, t, dt);  // restore the tangent at zNew
     }
     zNew.swap(trial_);
     ++outcome.iterations;
@@ -99,6 +97,19 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
                                .maxCoeff();
     residualNorm = rescaledNorm(system);
   }
+}
+
+double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
+                              double residualNorm) {
+  for (double step = 1.0; step >= kSmallestLineSearchStep; step *= 0.5) {
+    trial_ = zNew + step * increment_;
+    evaluate(zOld, trial_, t, dt);
+    const double trialNorm = assembler_.relativeResidualNorm();
+    if (trialNorm <= (1.0 - 1e-4 * step) * residualNorm ||
+        (std::isfinite(trialNorm) && residualNorm <= settings_.residualTolerance))
+      return step;
+  }
+  return 0.0;
 }
 
 bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,

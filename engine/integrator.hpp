@@ -56,6 +56,10 @@ class Integrator {
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
+  // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
+  // evaluated at zNew + step increment_ in trial_); 0 if none does.
+  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
+                    double residualNorm);
 
   const Model& model_;
   Scheme scheme_;

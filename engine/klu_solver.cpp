@@ -3,8 +3,10 @@
 namespace mpx {
 
 namespace {
-// Re-pivot when the cheap reciprocal pivot-growth estimate falls below this.
-constexpr double kRepivotRcond = 1e-12;
+// Re-pivot when the reciprocal pivot growth of the reused pivots falls below this (a stable
+// factorisation has growth of order one; min/max |U_ii| would be the wrong test here: saddle
+// points and mixed units make it tiny for perfectly good pivots).
+constexpr double kRepivotGrowth = 1e-8;
 }  // namespace
 
 KluSolver::KluSolver() { klu_defaults(&common_); }
@@ -14,7 +16,7 @@ KluSolver::~KluSolver() {
   if (symbolic_) klu_free_symbolic(&symbolic_, &common_);
 }
 
-bool KluSolver::factorize(const Eigen::SparseMatrix<double>& matrix) {
+bool KluSolver::factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) {
   // Eigen and KLU store the compressed columns the same way; KLU only reads them
   auto* colStart = const_cast<int*>(matrix.outerIndexPtr());
   auto* rowIndex = const_cast<int*>(matrix.innerIndexPtr());
@@ -25,12 +27,12 @@ bool KluSolver::factorize(const Eigen::SparseMatrix<double>& matrix) {
   if (!symbolic_) return false;
 
   // reuse the pivot order while it stays good
-  if (numeric_) {
+  if (numeric_ && !repivot) {
     if (klu_refactor(colStart, rowIndex, values, symbolic_, numeric_, &common_) &&
-        klu_rcond(symbolic_, numeric_, &common_) && common_.rcond > kRepivotRcond)
+        klu_rgrowth(colStart, rowIndex, values, symbolic_, numeric_, &common_) && common_.rgrowth > kRepivotGrowth)
       return true;
-    klu_free_numeric(&numeric_, &common_);
   }
+  if (numeric_) klu_free_numeric(&numeric_, &common_);
   numeric_ = klu_factor(colStart, rowIndex, values, symbolic_, &common_);
   return numeric_ != nullptr && common_.status == KLU_OK;
 }

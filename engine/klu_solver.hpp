@@ -2,7 +2,8 @@
 // Sparse LU with SuiteSparse KLU for the Newton tangent. The pattern is fixed for a run: the
 // symbolic analysis is done once, the first numeric factorisation chooses pivots, and later
 // factorisations reuse them through klu_refactor, which allocates nothing. When the reused
-// pivots become poor (reciprocal condition estimate below a threshold) KLU re-pivots.
+// pivots become poor (reciprocal pivot growth below a threshold), or the caller asks, KLU
+// pivots afresh.
 #include <Eigen/Sparse>
 #include <klu.h>
 
@@ -15,9 +16,9 @@ class KluSolver {
   KluSolver(const KluSolver&) = delete;
   KluSolver& operator=(const KluSolver&) = delete;
 
-  // Factorise a compressed column-major matrix whose pattern never changes between calls.
-  // Returns false if the matrix is numerically singular.
-  bool factorize(const Eigen::SparseMatrix<double>& matrix);
+  // Factorise a compressed column-major matrix whose pattern never changes between calls,
+  // reusing the last pivots unless `repivot`. Returns false if the matrix is singular.
+  bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot = false);
   // Overwrite rhs with the solution of A x = rhs for the last factorised A.
   void solve(Eigen::VectorXd& rhs);
 

@@ -1,5 +1,6 @@
 // metriplex_step_benchmark: cost of one integrator step along a real trajectory (time, Newton
-// iterations, cut-backs) for the benchmark scenes and a generated chain of thermo-springs.
+// iterations, cut-backs) for the benchmark scenes and generated chains of thermo-springs and of
+// rigid links.
 // Reproduce and read the figures with docs/performance.md.
 #include "models/scene/scene_loader.hpp"
 
@@ -12,6 +13,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -24,6 +26,13 @@ using SceneSource = std::function<CompiledScene(std::optional<ThermalVariable>)>
 SceneSource sceneFile(const std::string& file) {
   return [file](std::optional<ThermalVariable> variable) {
     return loadScene(std::string(METRIPLEX_SCENES_DIR) + "/" + file, variable);
+  };
+}
+
+// Scenes generated in code are compiled from their XML text; `label` names them in messages.
+SceneSource sceneText(std::string xml, std::string label) {
+  return [xml = std::move(xml), label = std::move(label)](std::optional<ThermalVariable> variable) {
+    return loadSceneText(xml, label, variable);
   };
 }
 
@@ -45,6 +54,31 @@ std::string thermoSpringChainXml(int masses, double dt) {
     if (i > 1)
       xml << "  <heat_link name=\"h" << i << "\" a=\"s" << i - 1 << "\" b=\"s" << i << "\" conductivity=\"1\"/>\n";
   }
+  xml << "</metriplex>\n";
+  return xml.str();
+}
+
+// A chain of rigid links hinged to an anchor at the origin, released from rest horizontal in
+// gravity: link i (1 kg, a 0.5 x 0.05 x 0.05 m box) is centred at (0.25 + 0.5 i, 0, 0) and
+// joined to its predecessor by a revolute joint about y at their common end; `enforcement`
+// and `stiffness` become the scene's <constraints> default.
+std::string rigidChainXml(int links, const std::string& enforcement, double stiffness, double dt) {
+  const double mass = 1.0, length = 0.5, width = 0.05;
+  const double axial = mass * (width * width + width * width) / 12;
+  const double transverse = mass * (length * length + width * width) / 12;
+  std::ostringstream xml;
+  xml.precision(17);
+  xml << "<metriplex name=\"rigid_chain\">\n"
+      << "  <simulation dt=\"" << dt << "\" t_end=\"100\"/>\n"
+      << "  <constraints enforcement=\"" << enforcement << "\" stiffness=\"" << stiffness << "\"/>\n"
+      << "  <gravity g=\"0 0 -9.81\"/>\n"
+      << "  <anchor name=\"origin\" position=\"0 0 0\"/>\n";
+  const auto link = [](int i) { return i < 0 ? std::string("origin") : "l" + std::to_string(i); };
+  for (int i = 0; i < links; ++i)
+    xml << "  <body name=\"" << link(i) << "\" mass=\"" << mass << "\" inertia=\"" << axial << ' ' << transverse
+        << ' ' << transverse << "\" position=\"" << length * (i + 0.5) << " 0 0\"/>\n"
+        << "  <joint name=\"j" << i << "\" type=\"revolute\" a=\"" << link(i - 1) << "\" b=\"" << link(i)
+        << "\" anchor=\"" << length * i << " 0 0\" axis=\"0 1 0\"/>\n";
   xml << "</metriplex>\n";
   return xml.str();
 }
@@ -75,14 +109,16 @@ void stepBenchmark(benchmark::State& state, const std::shared_ptr<const Compiled
   state.counters["t_reached"] = t;
 }
 
-// A scheme as the command line names it: the EEM cases fix the thermal variable, the
-// standard rules run in the one the scene declares.
+// A scheme as the command line names it: the EEM cases of the thermal scenes fix the thermal
+// variable; plain EEM (for the rigid scenes, which have no thermal dofs) and the standard
+// rules run in the one the scene declares.
 struct SchemeChoice {
   const char* name;
   Scheme scheme;
   std::optional<ThermalVariable> variable;
 };
 
+const SchemeChoice kEem{"eem", Scheme::Eem, std::nullopt};
 const SchemeChoice kEemEntropy{"eem-entropy", Scheme::Eem, ThermalVariable::Entropy};
 const SchemeChoice kEemTemperature{"eem-temperature", Scheme::Eem, ThermalVariable::Temperature};
 const SchemeChoice kMidpoint{"midpoint", Scheme::Midpoint, std::nullopt};
@@ -109,12 +145,14 @@ int main(int argc, char** argv) {
                 {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
   registerCases("thermo_visco_elastic", sceneFile("thermo_visco_elastic.xml"),
                 {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
-  const std::string chain = thermoSpringChainXml(1000, 0.05);
-  registerCases("thermo_spring_chain_1000",
-                [&chain](std::optional<ThermalVariable> variable) {
-                  return loadSceneText(chain, "thermo_spring_chain", variable);
-                },
+  registerCases("thermo_spring_chain_1000", sceneText(thermoSpringChainXml(1000, 0.05), "thermo_spring_chain"),
                 {kEemEntropy, kEemTemperature, kMidpoint});
+  // rigid multibody: a long open chain under both enforcements, and a spatial closed loop
+  registerCases("rigid_chain_50", sceneText(rigidChainXml(50, "augmented_lagrangian", 1e4, 1e-3), "rigid_chain"),
+                {kEem});
+  registerCases("rigid_chain_50_penalty", sceneText(rigidChainXml(50, "penalty", 1e8, 1e-3), "rigid_chain"),
+                {kEem});
+  registerCases("slider_crank_spatial", sceneFile("slider_crank_spatial.xml"), {kEem, kMidpoint});
 
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
