@@ -164,7 +164,22 @@ std::vector<QuadraticForm> JointBuilder::coordinateInvariants(JointType type, co
     const AffineVector offset = difference(point(1, g.anchor), point(0, g.anchor));
     return {dot(offset, direction(0, g.axis), 0.0)};
   }
-  throw std::invalid_argument("joint forces act on revolute and prismatic joints only");
+  if (type == JointType::Spherical) {
+    // s = vee(skew(R)) = sin(psi) n with R_ij = a_i . b_j: the relative rotation vector to first
+    // order, s_x = (a_z.b_y - a_y.b_z)/2 and cyclic
+    std::vector<QuadraticForm> forms;
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      QuadraticForm s = dot(direction(0, Vec3::Unit(j)), direction(1, Vec3::Unit(i)), 0.0);
+      const QuadraticForm t = dot(direction(0, Vec3::Unit(i)), direction(1, Vec3::Unit(j)), 0.0);
+      s.hessian = 0.5 * (s.hessian - t.hessian);
+      s.gradient = 0.5 * (s.gradient - t.gradient);
+      s.constant = 0.5 * (s.constant - t.constant);
+      forms.push_back(std::move(s));
+    }
+    return forms;
+  }
+  throw std::invalid_argument("joint forces act on revolute, prismatic and spherical joints only");
 }
 
 std::vector<QuadraticForm> JointBuilder::rigidity() const {

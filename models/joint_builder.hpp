@@ -56,7 +56,8 @@ class JointBuilder {
   std::vector<QuadraticForm> rigidity() const;
   // Quadratic invariants that give a joint's coordinate: revolute (u, v) = (a1.b1, a2.b1) with
   // a1, a2 perpendicular to the axis on a and b1 on b (angle atan2(v, u), 0 at t = 0);
-  // prismatic s = (p_b - p_a).axis_a - s(0) (0 at t = 0). Throws for other joint types.
+  // prismatic s = (p_b - p_a).axis_a - s(0) (0 at t = 0); spherical (bushing) the three
+  // components of sin(psi) n, psi n the relative rotation (0 at t = 0). Throws for other types.
   std::vector<QuadraticForm> coordinateInvariants(JointType type, const JointGeometry& geometry) const;
 
  private:

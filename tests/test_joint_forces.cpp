@@ -59,5 +59,29 @@ TEST(DissipativeJoints, HeatingAReservoirKeepsEnergyAndProducesEntropy) {
   EXPECT_GT(h.entropy.back() - h.entropy.front(), 1e-4);
 }
 
+// Two free bodies on a spherical joint with a viscoelastic bushing (spring, damper and Maxwell
+// branch on the relative rotation): E + dissipated and both momenta are invariants.
+TEST(DissipativeJoints, BushingKeepsMomentaAndTheEnergyBalance) {
+  const CompiledScene scene = loadSceneText(R"(<metriplex name="bushing">
+    <simulation dt="0.01" t_end="5"/>
+    <body name="a" mass="1" inertia="0.02 0.03 0.04" position="0 0 0" angular_velocity="0.5 -1 2"/>
+    <body name="b" mass="2" inertia="0.05 0.04 0.03" position="0.6 0 0" velocity="0 0 1"
+          angular_velocity="-1 0.5 0.2"/>
+    <joint name="ball" type="spherical" a="a" b="b" anchor="0.3 0 0"/>
+    <joint_force name="bushing" joint="ball" stiffness="2" damping="0.05" branch_stiffness="1" viscosity="0.2"/>
+  </metriplex>)",
+                                            "bushing");
+  const History h = run(*scene.model, Scheme::Eem, scene.settings.dt, scene.settings.tEnd);
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const double scale = std::abs(h.energy.front());
+  for (std::size_t n = 1; n < h.energy.size(); ++n) {
+    ASSERT_NEAR(h.energy[n] + h.dissipated[n], h.energy[0], 1e-10 * scale) << "step " << n;
+    ASSERT_LE((h.momentum[n] - h.momentum[0]).norm(), 1e-10 * h.momentum[0].norm()) << "step " << n;
+    ASSERT_LE((h.angularMomentum[n] - h.angularMomentum[0]).norm(), 1e-10 * h.angularMomentum[0].norm())
+        << "step " << n;
+  }
+  EXPECT_GT(h.dissipated.back(), 1e-3 * scale);
+}
+
 }  // namespace
 }  // namespace mpx::test

@@ -85,7 +85,7 @@ std::string thermoMaxwellChain(ThermalVariable variable) {
 // Two rigid bodies on a revolute hinge (augmented Lagrangian) and a prismatic slider
 // (penalty), with a torsional spring, a Maxwell branch, damping and friction heating a
 // reservoir, and a nonlinear spring, a Maxwell branch and a damper on the slider dissipating
-// without a thermal node.
+// without a thermal node; a third body on a spherical joint with a viscoelastic bushing.
 std::string dissipativeJoints(ThermalVariable) {
   return R"(<gravity g="0 0 -9.81"/>
     <anchor name="ground" position="0 0 0"/>
@@ -99,7 +99,11 @@ std::string dissipativeJoints(ThermalVariable) {
     <joint_force name="hinge_losses" joint="hinge" stiffness="3" rest="0.2" damping="0.4" friction="0.1"
                  friction_velocity="0.5" branch_stiffness="2" viscosity="0.6" heat_node="bearing"/>
     <joint_force name="slide_spring" joint="slide" stiffness="20" rest="0.05" cubic_stiffness="50" damping="0.3"
-                 friction="0.2" friction_velocity="0.3" branch_stiffness="8" viscosity="0.4"/>)";
+                 friction="0.2" friction_velocity="0.3" branch_stiffness="8" viscosity="0.4"/>
+    <body name="bob" mass="0.3" inertia="0.01 0.015 0.02" position="1.5 0 0.1" angular_velocity="0.3 -0.5 1"/>
+    <joint name="ball" type="spherical" a="slider" b="bob" anchor="1.4 0 0.1"/>
+    <joint_force name="bushing" joint="ball" stiffness="4" damping="0.2" branch_stiffness="1" viscosity="0.3"
+                 heat_node="bearing"/>)";
 }
 
 struct SceneBody {

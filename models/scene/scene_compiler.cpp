@@ -17,10 +17,14 @@ namespace {
 bool ownsThermalDof(const std::string& tag) {
   return tag == "thermo_spring" || tag == "thermo_maxwell" || tag == "reservoir";
 }
-bool ownsInternalDof(const XMLElement& element) {
+// jointTypes: the type attribute of every <joint> by name (a bushing branch has three).
+int internalDofsOf(const XMLElement& element, const std::map<std::string, std::string>& jointTypes) {
   const std::string tag = element.Name();
-  return tag == "maxwell" || tag == "thermo_maxwell" ||
-         (tag == "joint_force" && element.Attribute("branch_stiffness") != nullptr);
+  if (tag == "maxwell" || tag == "thermo_maxwell") return 1;
+  if (tag != "joint_force" || !element.Attribute("branch_stiffness")) return 0;
+  const char* joint = element.Attribute("joint");
+  const auto type = joint ? jointTypes.find(joint) : jointTypes.end();
+  return type != jointTypes.end() && type->second == "spherical" ? 3 : 1;
 }
 
 }  // namespace
@@ -33,11 +37,14 @@ CompiledScene SceneCompiler::compile() {
 
   // the layout from a count of what owns dofs
   int positions = 0, thermal = 0, internal = 0, multipliers = 0;
+  std::map<std::string, std::string> jointTypes;
+  for (const XMLElement* e = root_.FirstChildElement("joint"); e; e = e->NextSiblingElement("joint"))
+    if (e->Attribute("name") && e->Attribute("type")) jointTypes[e->Attribute("name")] = e->Attribute("type");
   for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
     positions += tag == "mass" ? 3 : tag == "body" ? 12 : 0;
     thermal += ownsThermalDof(tag);
-    internal += ownsInternalDof(*e);
+    internal += internalDofsOf(*e, jointTypes);
     multipliers += multipliersOf(*e);
   }
   layout_ = Layout({positions, positions, thermal, internal, multipliers});

@@ -158,22 +158,27 @@ void SceneCompiler::addJointForce(ElementReader& in) {
   const std::string jointName = in.text("joint");
   const auto joint = joints_.find(jointName);
   if (joint == joints_.end()) in.fail("attribute 'joint': no joint named '" + jointName + "' declared above");
-  if (joint->second.type != JointType::Revolute && joint->second.type != JointType::Prismatic)
-    in.fail("joint '" + jointName + "' is not revolute or prismatic: joint forces act on those coordinates");
+  const JointType type = joint->second.type;
+  if (type != JointType::Revolute && type != JointType::Prismatic && type != JointType::Spherical)
+    in.fail("joint '" + jointName + "' is not revolute, prismatic or spherical: joint forces act on those");
   const JointBuilder builder(joint->second.a, joint->second.b);
-  spec.revolute = joint->second.type == JointType::Revolute;
+  spec.revolute = type == JointType::Revolute;
   spec.positionDofs = builder.positionDofs();
   spec.velocityShift = layout_.offset(Block::Velocity) - layout_.offset(Block::Position);
-  spec.invariants = builder.coordinateInvariants(joint->second.type, joint->second.geometry);
+  std::vector<QuadraticForm> invariants;
+  try {
+    invariants = builder.coordinateInvariants(type, joint->second.geometry);
+  } catch (const std::invalid_argument& e) {
+    in.fail(e.what());
+  }
   spec.stiffness = in.nonNegative("stiffness", 0.0);
   spec.rest = in.number("rest", joint->second.coordinate) - joint->second.coordinate;
   spec.cubicStiffness = in.nonNegative("cubic_stiffness", 0.0);
-  if (spec.revolute && spec.cubicStiffness > 0.0) in.fail("cubic_stiffness applies to prismatic joints only");
-  if (in.has("branch_stiffness")) {
+  if (spec.revolute && spec.cubicStiffness > 0.0) in.fail("cubic_stiffness applies to prismatic and spherical joints");
+  const bool branch = in.has("branch_stiffness");
+  if (branch) {
     spec.branchStiffness = in.positive("branch_stiffness");
     spec.viscosity = in.positive("viscosity");
-    spec.internalDof = layout_.dof(Block::Internal, internalCount_++);
-    scale_[spec.internalDof] = 1.0;
   }
   spec.damping = in.nonNegative("damping", 0.0);
   spec.friction = in.nonNegative("friction", 0.0);
@@ -183,7 +188,22 @@ void SceneCompiler::addJointForce(ElementReader& in) {
     if (node.thermalDof < 0) in.fail("heat_node must have a heat capacity (not a fixed temperature)");
     spec.heatDof = node.thermalDof;
   }
-  components_.push_back(std::make_unique<JointForce>(std::move(spec)));
+  // a revolute or prismatic coordinate is one element; a spherical bushing one per axis
+  std::vector<std::vector<QuadraticForm>> coordinates;
+  if (type == JointType::Spherical)
+    for (const QuadraticForm& axis : invariants) coordinates.push_back({axis});
+  else
+    coordinates.push_back(invariants);
+  for (std::size_t k = 0; k < coordinates.size(); ++k) {
+    JointForceSpec element = spec;
+    if (coordinates.size() > 1) element.name += std::string(".") + "xyz"[k];
+    element.invariants = coordinates[k];
+    if (branch) {
+      element.internalDof = layout_.dof(Block::Internal, internalCount_++);
+      scale_[element.internalDof] = 1.0;
+    }
+    components_.push_back(std::make_unique<JointForce>(std::move(element)));
+  }
 }
 
 }  // namespace mpx
