@@ -3,6 +3,7 @@
 // held to round-off by the augmented Lagrangian and to O(1/kappa) by penalties, and the
 // assembled step tangent consistent with its residual for every joint type.
 #include "support.hpp"
+#include "tangent_check.hpp"
 
 #include <gtest/gtest.h>
 
@@ -268,39 +269,6 @@ std::string everyJointType(const std::string& enforcement) {
     </metriplex>)";
 }
 
-// A fixed pseudo-random vector: entries +-[0.5, 1] times `magnitude`.
-VectorXd randomIsh(const VectorXd& magnitude, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> size(0.5, 1.0);
-  std::bernoulli_distribution negative(0.5);
-  VectorXd out(magnitude.size());
-  for (Eigen::Index i = 0; i < out.size(); ++i)
-    out[i] = (negative(generator) ? -1.0 : 1.0) * size(generator) * magnitude[i];
-  return out;
-}
-
-// Worst row of |K - K_fd| relative to the row's largest entry, columns weighted by the dof
-// magnitudes so that entries of different units compare alike.
-struct Mismatch {
-  double relative = 0.0;
-  Eigen::Index row = 0, col = 0;
-};
-
-Mismatch worstRowMismatch(const MatrixXd& analytic, const MatrixXd& numeric, const VectorXd& magnitude) {
-  const MatrixXd weight = VectorXd::Ones(analytic.rows()) * magnitude.transpose();
-  const MatrixXd error = (analytic - numeric).cwiseAbs().cwiseProduct(weight);
-  const MatrixXd size = analytic.cwiseAbs().cwiseMax(numeric.cwiseAbs()).cwiseProduct(weight);
-  Mismatch worst;
-  for (Eigen::Index i = 0; i < analytic.rows(); ++i) {
-    const double rowSize = size.row(i).maxCoeff();
-    if (rowSize == 0.0) continue;
-    Eigen::Index col = 0;
-    const double relative = error.row(i).maxCoeff(&col) / rowSize;
-    if (relative > worst.relative) worst = {relative, i, col};
-  }
-  return worst;
-}
-
 struct TangentCase {
   const char* enforcement;
   double offset;        // zNew = zOld + offset * random: 0 is where Newton starts every step
@@ -324,21 +292,8 @@ TEST_P(RigidStepTangent, MatchesCentralDifferencesOfTheResidual) {
   const VectorXd zNew = zOld + c.offset * randomIsh(magnitude, 7);
 
   const MatrixXd analytic(integrator.evaluate(zOld, zNew, t, dt).tangent());
-  MatrixXd numeric(zNew.size(), zNew.size());
-  for (Eigen::Index j = 0; j < zNew.size(); ++j) {
-    const double h = c.relativeStep * magnitude[j];
-    VectorXd forward = zNew, backward = zNew;
-    forward[j] += h;
-    backward[j] -= h;
-    const VectorXd rForward = integrator.evaluate(zOld, forward, t, dt).residual();
-    numeric.col(j) = (rForward - integrator.evaluate(zOld, backward, t, dt).residual()) / (2.0 * h);
-  }
-  const Mismatch worst = worstRowMismatch(analytic, numeric, magnitude);
-  const Layout& layout = model.layout();
-  EXPECT_LT(worst.relative, 1e-6) << "row " << worst.row << " (" << blockName(layout.blockOf(worst.row)) << "), column "
-                                  << worst.col << " (" << blockName(layout.blockOf(worst.col)) << "): tangent "
-                                  << analytic(worst.row, worst.col) << ", finite differences "
-                                  << numeric(worst.row, worst.col);
+  const auto residual = [&](const VectorXd& z) -> VectorXd { return integrator.evaluate(zOld, z, t, dt).residual(); };
+  expectTangentMatches(model, analytic, centralDifferences(residual, zNew, magnitude, c.relativeStep), magnitude, 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(BothEnforcements, RigidStepTangent,

@@ -3,18 +3,23 @@
 // together hold every scene element, in both thermal variables, and the components' rate form
 // alpha dF/dz + beta dF/dzdot for arbitrary alpha, beta.
 #include "support.hpp"
+#include "tangent_check.hpp"
 
 #include <gtest/gtest.h>
 
 #include <functional>
 #include <optional>
 #include <ostream>
-#include <random>
 #include <string>
 #include <vector>
 
 namespace mpx {
 namespace {
+
+using test::centralDifferences;
+using test::expectTangentMatches;
+using test::magnitudeAt;
+using test::randomIsh;
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -128,68 +133,6 @@ CompiledScene compile(const SceneBody& scene, ThermalVariable variable, Discrete
   return loadSceneText("<metriplex>" + simulation + scene.body(variable) + "</metriplex>", scene.name, variable);
 }
 
-// A fixed pseudo-random vector: entries +-[0.5, 1] times `magnitude`, never near zero.
-VectorXd randomIsh(const VectorXd& magnitude, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> size(0.5, 1.0);
-  std::bernoulli_distribution negative(0.5);
-  VectorXd out(magnitude.size());
-  for (Eigen::Index i = 0; i < out.size(); ++i)
-    out[i] = (negative(generator) ? -1.0 : 1.0) * size(generator) * magnitude[i];
-  return out;
-}
-
-// Typical magnitude of each dof at z: |z_i| plus the model's scale.
-VectorXd magnitudeAt(const Model& model, const VectorXd& z) { return z.cwiseAbs() + model.dofScale(); }
-
-using ResidualFunction = std::function<VectorXd(const VectorXd&)>;
-
-// Central differences of `residual` at x, column j with step relativeStep * magnitude_j.
-MatrixXd centralDifferences(const ResidualFunction& residual, const VectorXd& x, const VectorXd& magnitude,
-                            double relativeStep) {
-  MatrixXd jacobian(x.size(), x.size());
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    const double h = relativeStep * magnitude[j];
-    VectorXd forward = x, backward = x;
-    forward[j] += h;
-    backward[j] -= h;
-    jacobian.col(j) = (residual(forward) - residual(backward)) / (2.0 * h);
-  }
-  return jacobian;
-}
-
-// Each row's largest mismatch relative to the row's largest term, with columns weighted by
-// the dof magnitudes so that entries of different units compare alike; the worst row wins.
-struct Mismatch {
-  double relative = 0.0;
-  Eigen::Index row = 0, col = 0;
-};
-
-Mismatch worstRowMismatch(const MatrixXd& analytic, const MatrixXd& numeric, const VectorXd& magnitude) {
-  const MatrixXd weight = VectorXd::Ones(analytic.rows()) * magnitude.transpose();
-  const MatrixXd error = (analytic - numeric).cwiseAbs().cwiseProduct(weight);
-  const MatrixXd size = analytic.cwiseAbs().cwiseMax(numeric.cwiseAbs()).cwiseProduct(weight);
-  Mismatch worst;
-  for (Eigen::Index i = 0; i < analytic.rows(); ++i) {
-    const double rowSize = size.row(i).maxCoeff();
-    if (rowSize == 0.0) continue;
-    Eigen::Index col = 0;
-    const double relative = error.row(i).maxCoeff(&col) / rowSize;
-    if (relative > worst.relative) worst = {relative, i, col};
-  }
-  return worst;
-}
-
-void expectTangentMatches(const Model& model, const MatrixXd& analytic, const MatrixXd& numeric,
-                          const VectorXd& magnitude) {
-  const Mismatch worst = worstRowMismatch(analytic, numeric, magnitude);
-  const Layout& layout = model.layout();
-  EXPECT_LT(worst.relative, kTolerance) << "row " << worst.row << " (" << blockName(layout.blockOf(worst.row))
-                                        << "), column " << worst.col << " (" << blockName(layout.blockOf(worst.col))
-                                        << "): tangent " << analytic(worst.row, worst.col) << ", finite differences "
-                                        << numeric(worst.row, worst.col);
-}
-
 struct StepCase {
   const SceneBody* scene;
   ThermalVariable variable;
@@ -239,7 +182,7 @@ class StepTangent : public testing::TestWithParam<StepCase> {
     };
     const VectorXd magnitude = magnitudeAt(*scene_.model, zNew);
     expectTangentMatches(*scene_.model, analytic, centralDifferences(residual, zNew, magnitude, relativeStep),
-                         magnitude);
+                         magnitude, kTolerance);
   }
 
   CompiledScene scene_;
@@ -311,7 +254,7 @@ TEST(RateTangent, MatchesSeparateFiniteDifferencesInStateAndRate) {
       const auto inRate = [&](const VectorXd& x) { return assembleRate(model, z, x, alpha, beta).residual; };
       const MatrixXd numeric = alpha * centralDifferences(inState, z, magnitude, 1e-6) +
                                beta * centralDifferences(inRate, zdot, magnitude, 1e-6);
-      expectTangentMatches(model, assembleRate(model, z, zdot, alpha, beta).tangent, numeric, magnitude);
+      expectTangentMatches(model, assembleRate(model, z, zdot, alpha, beta).tangent, numeric, magnitude, kTolerance);
     }
 }
 
