@@ -106,6 +106,18 @@ double JointForce::dissipativeForce(double rate, double* dForce) const {
   return spec_.damping * rate + spec_.friction * slip;
 }
 
+void JointForce::deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out,
+                         Flows& flows) const {
+  // the dissipated power heats the node, or leaves the system
+  if (localHeat_ < 0) {
+    flows.dissipated += power;
+    return;
+  }
+  out.residual()[localHeat_] -= power;
+  out.tangent().block(localHeat_, 0, 1, n_) -= dPowerDq;
+  if (localInternal_ >= 0) out.tangent()(localHeat_, localInternal_) -= dPowerDgamma;
+}
+
 void JointForce::measure(const double* z, Measures& out) const { out.energy += energy(arguments(z)).value; }
 
 void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
@@ -154,14 +166,7 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
     dPowerDgamma = 2.0 * g / nu * dgDgamma;
   }
 
-  // the dissipated power heats the node, or leaves the system
-  if (localHeat_ < 0) {
-    flows.dissipated += power;
-    return;
-  }
-  r[localHeat_] -= power;
-  K.block(localHeat_, 0, 1, n_) -= dPowerDq;
-  if (localInternal_ >= 0) K(localHeat_, localInternal_) -= dPowerDgamma;
+  deposit(power, dPowerDq, dPowerDgamma, out, flows);
 }
 
 void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
@@ -204,13 +209,7 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
     dPowerDq += args.alpha * (2.0 * g / nu) * dgDq;
     dPowerDgamma = -args.alpha * (2.0 * g / nu) * e.hess(kInternal, kInternal);
   }
-  if (localHeat_ < 0) {
-    flows.dissipated += power;
-    return;
-  }
-  r[localHeat_] -= power;
-  K.block(localHeat_, 0, 1, n_) -= dPowerDq;
-  if (localInternal_ >= 0) K(localHeat_, localInternal_) -= dPowerDgamma;
+  deposit(power, dPowerDq, dPowerDgamma, out, flows);
 }
 
 }  // namespace mpx
