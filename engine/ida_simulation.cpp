@@ -12,7 +12,6 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -257,19 +256,8 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
   RunSummary summary;
   IdaProblem ida(model, options);
   const int n = model.layout().total();
-  Eigen::VectorXd state = model.initialState();
-  Measures measures;
-  model.measure(state, measures);
-  ConservationMonitor monitor(measures, summary);
-
-  StepRecord record;
-  record.state = &state;
-  record.measures = &measures;
-  sink(record);
-
   const auto outputs = static_cast<int>(std::ceil(options.tEnd / options.outputStep - 1e-9));
-  const int progressEvery = std::max(1, outputs / 100);
-  const auto start = std::chrono::steady_clock::now();
+  RunReporter reporter(model, summary, sink, progress, outputs);
   auto fail = [&](int output, double t, const std::string& what) {
     summary.failed = true;
     summary.failedStep = output;
@@ -283,26 +271,19 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
   for (int k = 1; k <= outputs && !summary.failed; ++k) {
     const double tout = k == outputs ? options.tEnd : k * options.outputStep;
     if (!ida.advanceTo(tout)) {
-      fail(k, record.time, "IDASolve failed");
+      fail(k, reporter.last().time, "IDASolve failed");
       break;
     }
-    state = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
-    model.measure(state, measures);
+    // the model's unknowns, then the accumulated boundary energies
+    reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
     const IdaStatistics stats = ida.statistics();
-    record.step = k;
-    record.time = tout;
-    record.dissipated = ida.state()[n];
-    record.externalWork = ida.state()[n + 1];
-    record.boundaryHeat = ida.state()[n + 2];
-    record.newtonIterations = static_cast<int>(stats.nonlinearIterations - previousIterations);
-    record.cutbacks = static_cast<int>(stats.errorTestFailures - previousErrorTestFailures);
+    reporter.report(k, tout, {ida.state()[n], ida.state()[n + 1], ida.state()[n + 2]},
+                    static_cast<int>(stats.nonlinearIterations - previousIterations),
+                    static_cast<int>(stats.errorTestFailures - previousErrorTestFailures));
     previousIterations = stats.nonlinearIterations;
     previousErrorTestFailures = stats.errorTestFailures;
-    sink(record);
-    monitor.observe(record);
-    if (progress && k % progressEvery == 0) progress(static_cast<double>(k) / outputs);
   }
-  summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  reporter.finish();
   summary.ida = ida.statistics();
   summary.newtonIterations = summary.ida->nonlinearIterations;
   summary.cutbacks = static_cast<int>(summary.ida->errorTestFailures);

@@ -1,46 +1,66 @@
 #include "simulation.hpp"
 
-#include <chrono>
 #include <cmath>
 
 namespace mpx {
 
-ConservationMonitor::ConservationMonitor(const Measures& initial, RunSummary& summary)
-    : initialEnergy_(initial.energy), previousEntropy_(initial.entropy), summary_(summary) {}
+RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps)
+    : model_(model),
+      summary_(summary),
+      sink_(std::move(sink)),
+      progress_(std::move(progress)),
+      steps_(steps),
+      progressEvery_(std::max(1, steps / 100)),
+      state_(model.initialState()),
+      start_(std::chrono::steady_clock::now()) {
+  model_.measure(state_, measures_);
+  initialEnergy_ = measures_.energy;
+  previousEntropy_ = measures_.entropy;
+  record_.state = &state_;
+  record_.measures = &measures_;
+  sink_(record_);
+}
 
-void ConservationMonitor::observe(const StepRecord& r) {
-  const Measures& m = *r.measures;
-  const double balance = m.energy + r.dissipated - r.externalWork - r.boundaryHeat - initialEnergy_;
-  summary_.maxEnergyBalanceError = std::max(summary_.maxEnergyBalanceError, std::abs(balance) / std::abs(initialEnergy_));
-  const double entropyIncrement = m.entropy - previousEntropy_;
-  summary_.minEntropyIncrement =
-      r.step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
-  previousEntropy_ = m.entropy;
-  summary_.steps = r.step;
+void RunReporter::report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks) {
+  model_.measure(state_, measures_);
+  record_.step = step;
+  record_.time = time;
+  record_.dissipated = crossed.dissipated;
+  record_.externalWork = crossed.externalWork;
+  record_.boundaryHeat = crossed.boundaryHeat;
+  record_.newtonIterations = newtonIterations;
+  record_.cutbacks = cutbacks;
+  sink_(record_);
+
+  // conservation figures: the energy balance against t = 0, the smallest entropy increment
+  const double balance =
+      measures_.energy + crossed.dissipated - crossed.externalWork - crossed.boundaryHeat - initialEnergy_;
+  summary_.maxEnergyBalanceError =
+      std::max(summary_.maxEnergyBalanceError, std::abs(balance) / std::abs(initialEnergy_));
+  const double entropyIncrement = measures_.entropy - previousEntropy_;
+  summary_.minEntropyIncrement = step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
+  previousEntropy_ = measures_.entropy;
+  summary_.steps = step;
+  if (progress_ && step % progressEvery_ == 0) progress_(static_cast<double>(step) / steps_);
+}
+
+void RunReporter::finish() {
+  summary_.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
                     const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
-  Eigen::VectorXd state = model.initialState(), next(state.size());
-  Measures measures;
-  model.measure(state, measures);
-  ConservationMonitor monitor(measures, summary);
-
-  StepRecord record;
-  record.state = &state;
-  record.measures = &measures;
-  sink(record);
-
   // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
   const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
-  const int progressEvery = std::max(1, steps / 100);
-  const auto start = std::chrono::steady_clock::now();
+  RunReporter reporter(model, summary, sink, progress, steps);
+  Eigen::VectorXd next(reporter.state().size());
+  StepEnergy crossed;
   for (int n = 1; n <= steps; ++n) {
-    const double t = record.time;
+    const double t = reporter.last().time;
     const double dt = std::min(options.dt, options.tEnd - t);
-    const StepOutcome outcome = integrator.advance(state, t, dt, next);
+    const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next);
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
     if (!outcome.converged) {
@@ -50,20 +70,13 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
       summary.failure = outcome.failure;
       break;
     }
-    state.swap(next);
-    model.measure(state, measures);
-    record.step = n;
-    record.time = n == steps ? options.tEnd : t + dt;
-    record.dissipated += outcome.energy.dissipated;
-    record.externalWork += outcome.energy.externalWork;
-    record.boundaryHeat += outcome.energy.boundaryHeat;
-    record.newtonIterations = outcome.iterations;
-    record.cutbacks = outcome.cutbacks;
-    sink(record);
-    monitor.observe(record);
-    if (progress && n % progressEvery == 0) progress(static_cast<double>(n) / steps);
+    reporter.state().swap(next);
+    crossed.dissipated += outcome.energy.dissipated;
+    crossed.externalWork += outcome.energy.externalWork;
+    crossed.boundaryHeat += outcome.energy.boundaryHeat;
+    reporter.report(n, n == steps ? options.tEnd : t + dt, crossed, outcome.iterations, outcome.cutbacks);
   }
-  summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  reporter.finish();
   return summary;
 }
 

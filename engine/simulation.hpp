@@ -3,6 +3,7 @@
 // sink, and summarise the run (cost, conservation, failure).
 #include "integrator.hpp"
 
+#include <chrono>
 #include <functional>
 #include <optional>
 #include <string>
@@ -54,21 +55,37 @@ struct RunSummary {
   std::string failure;
 };
 
-// Keeps a run summary's conservation figures (energy balance error, entropy increments) up to
-// date as step records arrive; shared by the fixed-step and the IDA loops.
-class ConservationMonitor {
- public:
-  ConservationMonitor(const Measures& initial, RunSummary& summary);
-  void observe(const StepRecord& record);
-
- private:
-  double initialEnergy_, previousEntropy_;
-  RunSummary& summary_;
-};
-
 using StepSink = std::function<void(const StepRecord&)>;
 // Called with the fraction of the run done, at most about a hundred times.
 using ProgressSink = std::function<void(double)>;
+
+// What the time loops share: the current state, its measures and the record handed to the
+// sink; the summary's conservation figures (energy balance error, entropy increments) and
+// wall time; the progress bar. Constructing it reports the initial state as step 0.
+class RunReporter {
+ public:
+  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps);
+
+  // The state the next report() describes; loops advance it in place.
+  Eigen::VectorXd& state() { return state_; }
+  const StepRecord& last() const { return record_; }
+  // Report state() as `step` at `time`; `crossed` holds the energies crossed since t = 0.
+  void report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks);
+  // Record the wall time since construction in the summary.
+  void finish();
+
+ private:
+  const Model& model_;
+  RunSummary& summary_;
+  StepSink sink_;
+  ProgressSink progress_;
+  int steps_, progressEvery_;
+  Eigen::VectorXd state_;
+  Measures measures_;
+  StepRecord record_;
+  double initialEnergy_ = 0.0, previousEntropy_ = 0.0;
+  std::chrono::steady_clock::time_point start_;
+};
 
 // Run from the model's initial state; step 0 reports the initial state. Stops at the first
 // step the integrator cannot complete (after its cut-backs) and reports it in the summary.
