@@ -11,6 +11,16 @@ namespace mpx::test {
 // Path of a file in scenes/.
 inline std::string scenePath(const std::string& file) { return std::string(METRIPLEX_SCENES_DIR) + "/" + file; }
 
+// Test-name fragment of a one-step scheme.
+inline std::string schemeName(Scheme scheme) {
+  switch (scheme) {
+    case Scheme::Eem: return "eem";
+    case Scheme::Midpoint: return "midpoint";
+    case Scheme::Trapezoidal: return "trapezoidal";
+  }
+  return "unknown";
+}
+
 // Everything a run reports, step by step.
 struct History {
   std::vector<double> time, energy, entropy, dissipated, externalWork, boundaryHeat;

@@ -77,6 +77,8 @@ int posix_memalign(void** result, std::size_t alignment, std::size_t size) noexc
 namespace mpx {
 namespace {
 
+using test::schemeName;
+
 // Allocator calls (allocations, releases) made by `work`.
 struct HeapTraffic {
   long allocations = 0;
@@ -132,15 +134,6 @@ TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
   EXPECT_TRUE(result.allConverged);
   EXPECT_EQ(result.traffic.allocations, 0);
   EXPECT_EQ(result.traffic.releases, 0);
-}
-
-std::string schemeName(Scheme scheme) {
-  switch (scheme) {
-    case Scheme::Eem: return "eem";
-    case Scheme::Midpoint: return "midpoint";
-    case Scheme::Trapezoidal: return "trapezoidal";
-  }
-  return "unknown";
 }
 
 INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,

@@ -20,6 +20,7 @@ using test::centralDifferences;
 using test::expectTangentMatches;
 using test::magnitudeAt;
 using test::randomIsh;
+using test::schemeName;
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -141,15 +142,6 @@ struct StepCase {
 };
 
 void PrintTo(const StepCase& c, std::ostream* out) { *out << c.scene->name; }
-
-std::string schemeName(Scheme scheme) {
-  switch (scheme) {
-    case Scheme::Eem: return "eem";
-    case Scheme::Midpoint: return "midpoint";
-    case Scheme::Trapezoidal: return "trapezoidal";
-  }
-  return "unknown";
-}
 
 std::vector<StepCase> stepCases() {
   std::vector<StepCase> cases;
