@@ -11,15 +11,16 @@ Assembler::Assembler(const Model& model) {
   residual_ = Eigen::VectorXd::Zero(n);
   rowScale_ = Eigen::VectorXd::Zero(n);
 
-  // pattern: every pair of a component's dofs, plus the diagonal
+  // pattern: the coupled pairs of each component's dofs, plus the diagonal
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < n; ++i) entries.emplace_back(i, i, 0.0);
   for (const auto& component : model.components()) {
     const auto& dofs = component->dofs();
     if (dofs.size() > static_cast<std::size_t>(kMaxLocalDofs))
       throw std::logic_error("component '" + component->name() + "' touches more than kMaxLocalDofs dofs");
-    for (int row : dofs)
-      for (int col : dofs) entries.emplace_back(row, col, 0.0);
+    for (std::size_t i = 0; i < dofs.size(); ++i)
+      for (std::size_t j = 0; j < dofs.size(); ++j)
+        if (component->couples(static_cast<int>(i), static_cast<int>(j))) entries.emplace_back(dofs[i], dofs[j], 0.0);
   }
   tangent_.resize(n, n);
   tangent_.setFromTriplets(entries.begin(), entries.end());
@@ -30,15 +31,26 @@ Assembler::Assembler(const Model& model) {
   const int* inner = tangent_.innerIndexPtr();
   for (const auto& component : model.components()) {
     const auto& dofs = component->dofs();
-    std::vector<int> index(dofs.size() * dofs.size());
+    std::vector<std::pair<int, int>> map;
     for (std::size_t j = 0; j < dofs.size(); ++j)
       for (std::size_t i = 0; i < dofs.size(); ++i) {
+        if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
         const int* begin = inner + outer[dofs[j]];
         const int* end = inner + outer[dofs[j] + 1];
-        index[i + j * dofs.size()] = static_cast<int>(std::lower_bound(begin, end, dofs[i]) - inner);
+        map.emplace_back(static_cast<int>(i + j * dofs.size()),
+                         static_cast<int>(std::lower_bound(begin, end, dofs[i]) - inner));
       }
-    valueIndex_.push_back(std::move(index));
+    scatterMap_.push_back(std::move(map));
   }
+  // rows of the prescribed velocities, to be overwritten
+  const auto& prescribed = model.prescribedVelocities();
+  prescribedRowEntries_.assign(prescribed.size(), {});
+  std::vector<int> prescribedIndex(n, -1);
+  for (std::size_t k = 0; k < prescribed.size(); ++k) prescribedIndex[prescribed[k].dof] = static_cast<int>(k);
+  for (int e = 0; e < outer[n]; ++e)
+    if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
+  for (const PrescribedVelocity& p : prescribed)
+    prescribedDiagonal_.push_back(static_cast<int>(std::lower_bound(inner + outer[p.dof], inner + outer[p.dof + 1], p.dof) - inner));
   localResidual_.assign(kMaxLocalDofs, 0.0);
   localTangent_.assign(kMaxLocalDofs * kMaxLocalDofs, 0.0);
 }
@@ -51,12 +63,35 @@ void Assembler::clear() {
 
 void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
                         double weight) {
-  const std::vector<int>& index = valueIndex_[component];
   double* values = tangent_.valuePtr();
   for (int i = 0; i < local.n; ++i) residual_[dofs[i]] += weight * local.r[i];
-  for (int e = 0; e < local.n * local.n; ++e) values[index[e]] += weight * local.k[e];
+  for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
 }
 
+void Assembler::replaceRow(std::size_t k, int dof, double value, double diagonal, double velocity) {
+  flows_.externalWork += residual_[dof] * velocity;
+  double* values = tangent_.valuePtr();
+  for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
+  values[prescribedDiagonal_[k]] = diagonal;
+  residual_[dof] = value;
+}
+
+void Assembler::imposeStepVelocities(const Model& model, const double* zOld, const double* zNew, double t, double dt) {
+  const auto& prescribed = model.prescribedVelocities();
+  for (std::size_t k = 0; k < prescribed.size(); ++k) {
+    const PrescribedVelocity& p = prescribed[k];
+    const double change = p.amplitude * (p.profile(t + dt) - p.profile(t));
+    replaceRow(k, p.dof, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, 0.5 * (zOld[p.dof] + zNew[p.dof]));
+  }
+}
+
+void Assembler::imposeRateVelocities(const Model& model, const double* z, const double* zdot, double t, double beta) {
+  const auto& prescribed = model.prescribedVelocities();
+  for (std::size_t k = 0; k < prescribed.size(); ++k) {
+    const PrescribedVelocity& p = prescribed[k];
+    replaceRow(k, p.dof, zdot[p.dof] - p.amplitude * p.profile.slope(t), beta, z[p.dof]);
+  }
+}
 
 void Assembler::updateRowScale(const Eigen::VectorXd& stateScale) {
   rowScale_.setZero();

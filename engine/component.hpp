@@ -11,9 +11,9 @@ namespace mpx {
 
 using Vec3 = Eigen::Vector3d;
 
-// Largest number of local dofs of one component: a joint between two rigid bodies touches
-// 2 x 12 positions, their 24 velocity rows and two multipliers per constraint (up to 6).
-inline constexpr int kMaxLocalDofs = 64;
+// Largest number of local dofs of one component: a viscoelastic 8-node hexahedron touches 24
+// positions, their 24 velocity rows and 6 internal variables at each of 8 quadrature points.
+inline constexpr int kMaxLocalDofs = 96;
 
 // Temperature of a thermal node as seen by the heat links that touch it: the discrete
 // temperature theta~ in an EEM step, theta(z) in a rate evaluation. The owner publishes it
@@ -89,6 +89,9 @@ class Component {
   // Coupling components (heat links) read node temperatures published by the others, so
   // they are evaluated after all non-coupling components.
   virtual bool isCoupling() const { return false; }
+  // Whether local residual row `row` may depend on local dof `column`. The tangent's sparsity
+  // pattern holds only such pairs; entries a component writes elsewhere are dropped.
+  virtual bool couples(int /*row*/, int /*column*/) const { return true; }
 
   // Add energy, entropy, momenta and node temperatures of state z.
   virtual void measure(const double* z, Measures& out) const = 0;

@@ -15,6 +15,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       scheme_(scheme),
       settings_(settings),
       assembler_(model),
+      solver_(model.layout(), assembler_.tangent()),
       workspace_(model.makeWorkspace()),
       zMid_(model.layout().total()),
       zDot_(model.layout().total()),
@@ -27,19 +28,24 @@ Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::Vector
   assembler_.clear();
   if (scheme_ == Scheme::Eem) {
     assembler_.addStep(model_, workspace_, {zOld.data(), zNew.data(), t, dt});
-    return assembler_;
+  } else {
+    addRateForm(zOld, zNew, t, dt);
   }
+  assembler_.imposeStepVelocities(model_, zOld.data(), zNew.data(), t, dt);
+  return assembler_;
+}
+
+void Integrator::addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
   zDot_ = (zNew - zOld) / dt;
   // midpoint: F(t + dt/2, (z + z')/2, (z' - z)/dt)
   if (scheme_ == Scheme::Midpoint) {
     zMid_ = 0.5 * (zOld + zNew);
     assembler_.addRate(model_, workspace_, {zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5, 1.0 / dt}, 1.0);
-    return assembler_;
+    return;
   }
   // trapezoidal: mean of F at both end points with the same (z' - z)/dt
   assembler_.addRate(model_, workspace_, {zOld.data(), zDot_.data(), t, 0.0, 1.0 / dt}, 0.5);
   assembler_.addRate(model_, workspace_, {zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
-  return assembler_;
 }
 
 bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
@@ -80,8 +86,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     for (bool repivot = false;;) {
       if (!solver_.factorize(system.tangent(), repivot))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
-      increment_ = -system.residual();
-      solver_.solve(increment_);
+      solver_.solve(system.residual(), increment_);
       step = lineSearch(zOld, t, dt, zNew, residualNorm);
       if (step > 0.0) break;
       if (repivot)

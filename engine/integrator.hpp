@@ -4,7 +4,7 @@
 // Newton-Raphson with the consistent tangent, a backtracking line search on the residual and
 // a bounded step cut-back.
 #include "assembler.hpp"
-#include "klu_solver.hpp"
+#include "condensed_solver.hpp"
 #include "model.hpp"
 
 #include <Eigen/Dense>
@@ -53,6 +53,8 @@ class Integrator {
   Scheme scheme() const { return scheme_; }
 
  private:
+  // Midpoint or trapezoidal residual of the step from the components' rate form.
+  void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
@@ -65,7 +67,7 @@ class Integrator {
   Scheme scheme_;
   NewtonSettings settings_;
   Assembler assembler_;
-  KluSolver solver_;
+  CondensedSolver solver_;
   Workspace workspace_;
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
   int unknownsWithScale_;  // dofs before the multiplier block: those in the increment test

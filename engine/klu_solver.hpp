@@ -4,23 +4,22 @@
 // factorisations reuse them through klu_refactor, which allocates nothing. When the reused
 // pivots become poor (reciprocal pivot growth below a threshold), or the caller asks, KLU
 // pivots afresh.
-#include <Eigen/Sparse>
+#include "sparse_lu.hpp"
+
 #include <klu.h>
 
 namespace mpx {
 
-class KluSolver {
+class KluSolver final : public SparseLu {
  public:
   KluSolver();
   ~KluSolver();
   KluSolver(const KluSolver&) = delete;
   KluSolver& operator=(const KluSolver&) = delete;
 
-  // Factorise a compressed column-major matrix whose pattern never changes between calls,
-  // reusing the last pivots unless `repivot`. Returns false if the matrix is singular.
-  bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot = false);
-  // Overwrite rhs with the solution of A x = rhs for the last factorised A.
-  void solve(Eigen::VectorXd& rhs);
+  // Reuses the last pivots unless `repivot`.
+  bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) override;
+  void solve(Eigen::VectorXd& rhs) override;
 
  private:
   klu_common common_;

@@ -4,6 +4,7 @@
 // workspaces owned by the integrator.
 #include "component.hpp"
 #include "layout.hpp"
+#include "time_function.hpp"
 
 #include <Eigen/Dense>
 
@@ -16,10 +17,19 @@ namespace mpx {
 // Which thermal variable the Thermal block holds.
 enum class ThermalVariable { Temperature, Entropy };
 
+// A velocity dof held at v(t) = amplitude * profile(t) (a clamped or driven node): its
+// momentum row is replaced by that condition, and the reaction force does boundary work.
+struct PrescribedVelocity {
+  int dof;
+  double amplitude;
+  TimeFunction profile;
+};
+
 class Model {
  public:
   Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
-        std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale);
+        std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
+        std::vector<PrescribedVelocity> prescribedVelocities = {});
 
   const Layout& layout() const { return layout_; }
   ThermalVariable thermalVariable() const { return thermalVariable_; }
@@ -29,6 +39,7 @@ class Model {
   const Eigen::VectorXd& initialState() const { return initialState_; }
   // Characteristic magnitude of each dof, used to weigh Newton increments.
   const Eigen::VectorXd& dofScale() const { return dofScale_; }
+  const std::vector<PrescribedVelocity>& prescribedVelocities() const { return prescribedVelocities_; }
 
   // Energy, entropy, momenta and node temperatures of state z; `out` is reused (no allocation
   // once sized).
@@ -42,6 +53,7 @@ class Model {
   std::vector<std::string> thermalNodeNames_;
   Eigen::VectorXd initialState_;
   Eigen::VectorXd dofScale_;
+  std::vector<PrescribedVelocity> prescribedVelocities_;
 };
 
 }  // namespace mpx

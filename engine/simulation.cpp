@@ -14,7 +14,7 @@ RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink,
       state_(model.initialState()),
       start_(std::chrono::steady_clock::now()) {
   model_.measure(state_, measures_);
-  initialEnergy_ = measures_.energy;
+  balance_ = EnergyBalance(measures_.energy);
   previousEntropy_ = measures_.entropy;
   record_.state = &state_;
   record_.measures = &measures_;
@@ -33,10 +33,9 @@ void RunReporter::report(int step, double time, const StepEnergy& crossed, int n
   sink_(record_);
 
   // conservation figures: the energy balance against t = 0, the smallest entropy increment
-  const double balance =
-      measures_.energy + crossed.dissipated - crossed.externalWork - crossed.boundaryHeat - initialEnergy_;
   summary_.maxEnergyBalanceError =
-      std::max(summary_.maxEnergyBalanceError, std::abs(balance) / std::abs(initialEnergy_));
+      std::max(summary_.maxEnergyBalanceError, balance_.relativeError(measures_.energy, crossed.dissipated,
+                                                                       crossed.externalWork, crossed.boundaryHeat));
   const double entropyIncrement = measures_.entropy - previousEntropy_;
   summary_.minEntropyIncrement = step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
   previousEntropy_ = measures_.entropy;

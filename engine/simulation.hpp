@@ -3,7 +3,9 @@
 // sink, and summarise the run (cost, conservation, failure).
 #include "integrator.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -39,13 +41,29 @@ struct IdaStatistics {
   long errorTestFailures = 0;
 };
 
+// The energy balance E + D - W - Q - E_0 of a run, relative to the largest of |E_0|, |E|, D,
+// |W| and |Q| seen so far: a body set moving by a load from E_0 = 0 has a scale too.
+class EnergyBalance {
+ public:
+  explicit EnergyBalance(double initialEnergy) : initial_(initialEnergy), scale_(std::abs(initialEnergy)) {}
+  double relativeError(double energy, double dissipated, double externalWork, double boundaryHeat) {
+    scale_ = std::max({scale_, std::abs(energy), std::abs(dissipated), std::abs(externalWork), std::abs(boundaryHeat)});
+    const double balance = energy + dissipated - externalWork - boundaryHeat - initial_;
+    return scale_ > 0.0 ? std::abs(balance) / scale_ : std::abs(balance);
+  }
+
+ private:
+  double initial_, scale_;
+};
+
 struct RunSummary {
   int steps = 0;
   long newtonIterations = 0;
   int cutbacks = 0;
   double wallSeconds = 0.0;
-  // max_n |E_n + D_n - W_n - Q_n - E_0| / |E_0|: energy drift net of dissipated energy D,
-  // external work W and boundary heat Q (the plain energy drift for an isolated system)
+  // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy seen (EnergyBalance):
+  // energy drift net of dissipated energy D, external work W and boundary heat Q (the plain
+  // energy drift for an isolated system)
   double maxEnergyBalanceError = 0.0;
   double minEntropyIncrement = 0.0;  // min_n (S_n - S_{n-1})
   std::optional<IdaStatistics> ida;  // set for IDA runs
@@ -83,7 +101,8 @@ class RunReporter {
   Eigen::VectorXd state_;
   Measures measures_;
   StepRecord record_;
-  double initialEnergy_ = 0.0, previousEntropy_ = 0.0;
+  EnergyBalance balance_{0.0};
+  double previousEntropy_ = 0.0;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -12,13 +12,17 @@ class TimeFunction {
   static TimeFunction ramp(double tStart, double tEnd);
   // The tumbling L-block load: t for t <= T/2, T - t for T/2 < t <= T, 0 after.
   static TimeFunction hat(double period);
+  // One sine arch: sin(pi t / duration) for 0 <= t <= duration, 0 otherwise.
+  static TimeFunction sinePulse(double duration);
   // Piecewise linear through (times[i], values[i]), times increasing; constant outside.
   static TimeFunction table(std::vector<double> times, std::vector<double> values);
 
   double operator()(double t) const;
+  // df/dt (the right derivative at kinks).
+  double slope(double t) const;
 
  private:
-  enum class Kind { Constant, Ramp, Hat, Table };
+  enum class Kind { Constant, Ramp, Hat, SinePulse, Table };
   Kind kind_ = Kind::Constant;
   double a_ = 1.0, b_ = 0.0;
   std::vector<double> times_, values_;

@@ -19,6 +19,11 @@ class Inertia final : public Component {
   Inertia(std::string name, int firstPositionDof, int firstVelocityDof, std::vector<InertiaBlock> blocks,
           const Vec3& gravity);
 
+  // kinematic rows: the dof's own position and velocity; momentum rows: its own velocity
+  bool couples(int row, int column) const override {
+    const int velocityRows = 3 * static_cast<int>(blocks_.size());
+    return column == row || (row < velocityRows && column == row + velocityRows);
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -47,6 +47,11 @@ class QuadraticConstraint final : public Component {
  public:
   explicit QuadraticConstraint(ConstraintSpec spec);
 
+  // GGL's kinematic rows see the positions and mu only (local order: q, v, lambda, mu)
+  bool couples(int row, int column) const override {
+    const int mus = 2 * positionCount_ + static_cast<int>(spec_.forms.size());
+    return row >= positionCount_ || column < positionCount_ || column >= mus;
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

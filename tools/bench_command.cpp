@@ -71,18 +71,19 @@ BenchRun measure(const Model& model, const Method& method, const MethodParameter
   for (int r = 0; r < repeats; ++r) {
     Measures last;
     Eigen::VectorXd lastState;
-    double initialEnergy = 0.0, initialEntropy = 0.0, previousEntropy = 0.0;
+    EnergyBalance balance(0.0);
+    double initialEntropy = 0.0, previousEntropy = 0.0;
     run.entropyViolations = 0;
     run.series.clear();
     const std::clock_t start = std::clock();
     run.summary = runMethod(model, method, parameters, [&](const StepRecord& record) {
       const Measures& m = *record.measures;
-      if (record.step == 0) initialEnergy = m.energy, initialEntropy = previousEntropy = m.entropy;
+      if (record.step == 0) balance = EnergyBalance(m.energy), initialEntropy = previousEntropy = m.entropy;
       if (m.entropy < previousEntropy - 1e-14 * std::abs(m.entropy)) ++run.entropyViolations;
       previousEntropy = m.entropy;
       if (keepSeries) {
-        const double balance = m.energy + record.dissipated - record.externalWork - record.boundaryHeat - initialEnergy;
-        run.series.push_back({record.time, std::abs(balance / initialEnergy), m.entropy - initialEntropy});
+        const double error = balance.relativeError(m.energy, record.dissipated, record.externalWork, record.boundaryHeat);
+        run.series.push_back({record.time, error, m.entropy - initialEntropy});
       }
       last = m;
       lastState = *record.state;

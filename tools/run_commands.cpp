@@ -114,7 +114,7 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
   else
     fmt::print("  cut-backs                {}\n", s.cutbacks);
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
-  fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / |E0|)\n",
+  fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
              s.maxEnergyBalanceError);
   fmt::print("  min entropy increment    {:.3e}\n", s.minEntropyIncrement);
   fmt::print("  history                  {}\n", r.history.string());

@@ -34,6 +34,7 @@ CompiledScene SceneCompiler::compile() {
     throw InputError(file_, root_.GetLineNum(),
                      std::string("the root element must be <metriplex>, found <") + root_.Name() + ">");
   readSettings();
+  loadSolidMeshes();
 
   // the layout from a count of what owns dofs
   int positions = 0, thermal = 0, internal = 0, multipliers = 0;
@@ -43,6 +44,7 @@ CompiledScene SceneCompiler::compile() {
   for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
     positions += tag == "mass" ? 3 : tag == "body" ? 12 : 0;
+    if (tag == "solid") positions += solidPositionDofs(*e, internal);
     thermal += ownsThermalDof(tag);
     internal += internalDofsOf(*e, jointTypes);
     multipliers += multipliersOf(*e);
@@ -63,8 +65,9 @@ CompiledScene SceneCompiler::compile() {
     scale_[p] = std::max(scale_[p], length);
     scale_[v] = std::max(std::abs(state_[v]), length / settings_.tEnd);
   }
-  auto model = std::make_unique<Model>(layout_, variable_, std::move(components_), thermalNodeNames_, state_, scale_);
-  return {settings_, std::move(model), std::move(bodyFrames_), std::move(jointCoordinates_)};
+  auto model = std::make_unique<Model>(layout_, variable_, std::move(components_), thermalNodeNames_, state_, scale_,
+                                      std::move(prescribedVelocities_));
+  return {settings_, std::move(model), std::move(bodyFrames_), std::move(jointCoordinates_), std::move(solids_)};
 }
 
 void SceneCompiler::readSettings() {
@@ -146,6 +149,12 @@ void SceneCompiler::addElement(const XMLElement& element) {
   else if (tag == "body") addBody(in);
   else if (tag == "joint") addJoint(in);
   else if (tag == "joint_force") addJointForce(in);
+  else if (tag == "solid") addSolid(in);
+  else if (tag == "traction") addTraction(in);
+  else if (tag == "body_force") addBodyForce(in);
+  else if (tag == "clamp") addPrescribedVelocity(in, true);
+  else if (tag == "prescribed_velocity") addPrescribedVelocity(in, false);
+  else if (tag == "solid_joint") addSolidJoint(in);
   else in.fail("unknown element (see docs/scene-format.md for the elements a scene may hold)");
   in.finish();
 }
@@ -352,6 +361,7 @@ TimeFunction readProfile(ElementReader& in) {
     return TimeFunction::ramp(start, end);
   }
   if (profile == "hat") return TimeFunction::hat(in.positive("period"));
+  if (profile == "sine_pulse") return TimeFunction::sinePulse(in.positive("duration"));
   if (profile == "table") {
     std::vector<double> times = in.numbers("times"), values = in.numbers("values");
     if (times.empty() || times.size() != values.size()) in.fail("'times' and 'values' need the same, non-zero count");
@@ -360,7 +370,7 @@ TimeFunction readProfile(ElementReader& in) {
       in.fail("'times' must be strictly increasing");
     return TimeFunction::table(std::move(times), std::move(values));
   }
-  in.fail("profile must be constant, ramp, hat or table, got '" + profile + "'");
+  in.fail("profile must be constant, ramp, hat, sine_pulse or table, got '" + profile + "'");
 }
 
 void SceneCompiler::addForce(ElementReader& in) {

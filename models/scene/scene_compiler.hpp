@@ -7,6 +7,7 @@
 #include "scene_loader.hpp"
 
 #include "engine/time_function.hpp"
+#include "models/fe/mesh.hpp"
 #include "models/heat_link.hpp"
 #include "models/joint_builder.hpp"
 #include "models/lumped_element.hpp"
@@ -52,6 +53,23 @@ class SceneCompiler {
   void addBody(ElementReader& in);
   void addJoint(ElementReader& in);
   void addJointForce(ElementReader& in);
+  // Finite-element solids (scene_solids.cpp).
+  void loadSolidMeshes();
+  // Position dofs of a <solid> (pre-pass), adding its viscous strains to `internal`.
+  int solidPositionDofs(const XMLElement& element, int& internal) const;
+  // Nodes a <solid_joint> holds (pre-pass, for its multipliers).
+  int solidJointNodes(const XMLElement& element) const;
+  void addSolid(ElementReader& in);
+  void addTraction(ElementReader& in);
+  void addBodyForce(ElementReader& in);
+  void addPrescribedVelocity(ElementReader& in, bool clamp);
+  void addSolidJoint(ElementReader& in);
+  // The solid named by attribute 'solid' and the sorted nodes of its set named by 'surface'.
+  const SolidOutput& solidOf(ElementReader& in);
+  std::vector<int> solidNodes(ElementReader& in, const SolidOutput& solid);
+  // Add one nodal force per entry of `forces` (node -> force), scaled by `profile`.
+  void addNodalForces(const std::string& name, const SolidOutput& solid, const std::map<int, Vec3>& forces,
+                      const TimeFunction& profile);
   // Penalty or augmented-Lagrangian enforcement of `forms`, with multipliers when needed.
   void addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
                      const ConstraintSettings& settings);
@@ -94,6 +112,9 @@ class SceneCompiler {
   std::map<std::string, DeclaredJoint> joints_;
   std::vector<BodyFrame> bodyFrames_;
   std::vector<JointCoordinate> jointCoordinates_;
+  std::map<std::string, std::shared_ptr<const Mesh>> solidMeshes_;  // by solid name, loaded before the layout
+  std::vector<SolidOutput> solids_;
+  std::vector<PrescribedVelocity> prescribedVelocities_;
   ConstraintSettings constraintDefaults_;
   int positionCount_ = 0, thermalCount_ = 0, internalCount_ = 0, multiplierCount_ = 0;
   double positionScale_ = 0.0;

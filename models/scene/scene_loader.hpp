@@ -3,6 +3,8 @@
 // end time, integrator, solver settings) come back beside the model.
 #include "engine/integrator.hpp"
 #include "engine/model.hpp"
+#include "models/fe/mesh.hpp"
+#include "models/fe/solid_element.hpp"
 #include "models/joint_coordinate.hpp"
 #include "models/lumped_element.hpp"
 
@@ -30,11 +32,22 @@ struct BodyFrame {
   Eigen::Matrix3d directorsToBody;
 };
 
+// A finite-element solid in the state: node n's position at firstPositionDof + 3 n, its
+// velocity velocityShift further; its cells (in mesh order) for stresses and output.
+struct SolidOutput {
+  std::string name;
+  std::shared_ptr<const Mesh> mesh;
+  int firstPositionDof;
+  int velocityShift;
+  std::vector<const SolidElement*> cells;
+};
+
 struct CompiledScene {
   SceneSettings settings;
   std::unique_ptr<Model> model;
   std::vector<BodyFrame> bodies;
   std::vector<JointCoordinate> joints;  // revolute and prismatic joints, for joints.csv
+  std::vector<SolidOutput> solids;
 };
 
 // Throws InputError (file, line, element, what is wrong) on any invalid input. When

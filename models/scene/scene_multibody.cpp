@@ -32,13 +32,14 @@ ConstraintSettings SceneCompiler::constraintSettings(ElementReader& in) {
 
 int SceneCompiler::multipliersOf(const XMLElement& element) const {
   const std::string tag = element.Name();
-  if (tag != "body" && tag != "joint") return 0;
+  if (tag != "body" && tag != "joint" && tag != "solid_joint") return 0;
   const char* enforcement = element.Attribute("enforcement");
   const bool augmented = enforcement ? std::string(enforcement) == "augmented_lagrangian"
                                      : constraintDefaults_.enforcement == Enforcement::AugmentedLagrangian;
   if (!augmented) return 0;
   // two multipliers per constraint: lambda, and mu of the rate form (GGL)
   if (tag == "body") return 2 * 6;
+  if (tag == "solid_joint") return 2 * 3 * solidJointNodes(element);
   const char* type = element.Attribute("type");
   const std::optional<JointType> joint = type ? jointTypeByName(type) : std::nullopt;
   return joint ? 2 * constraintCount(*joint) : 0;  // a bad type is reported when the joint is read

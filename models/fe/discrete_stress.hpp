@@ -1,0 +1,32 @@
+#pragma once
+// Algorithmic stress S~ = 2 D_C W(C0, C1) of a hyperelastic law: Gonzalez discrete derivative of W with respect to C
+// in the Frobenius metric (eem-primer.md section 2),
+//   S~ = S(Cm) + 2 [W(C1) - W(C0) - S(Cm):dC/2] dC / (dC:dC),  Cm = (C0 + C1)/2, dC = C1 - C0,
+// so that S~:(C1 - C0)/2 = W(C1) - W(C0) exactly (directionality); symmetric in (C0, C1), hence second order. Below
+// a relative increment |dC| <= kQuotientSwitch max(|C0|, |C1|, 1) (Frobenius norms) it is S(Cm). Also its
+// derivative with respect to C1 for Newton's consistent tangent. Allocation-free: fixed-size matrices only.
+#include "models/fe/material.hpp"
+
+namespace mpx {
+
+class DiscreteStress {
+ public:
+  // Keeps a pointer to material, which must outlive this object.
+  DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1);
+  // S~
+  const Mat3& stress() const { return stress_; }
+  // dS~/dC1 [H] for a symmetric direction H
+  Mat3 increment(const Mat3& H) const;
+
+ private:
+  const HyperelasticMaterial* material_;
+  Mat3 midpoint_;        // Cm
+  Mat3 delta_;           // dC
+  Mat3 stress_;          // S~
+  Mat3 defectGradient_;  // G: derivative of the quotient's numerator N with respect to C1
+  double squaredDelta_;  // D = dC:dC
+  double kappa_ = 0.0;   // N / D
+  bool tiny_;            // below the quotient switch
+};
+
+}  // namespace mpx

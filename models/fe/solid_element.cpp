@@ -1,0 +1,178 @@
+#include "solid_element.hpp"
+
+#include "discrete_stress.hpp"
+
+namespace mpx {
+
+namespace {
+// Symmetric tensor components of a viscous strain, in the order of its dofs.
+constexpr int kComponent[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+
+std::vector<int> collectDofs(const SolidElementSpec& spec) {
+  std::vector<int> dofs;
+  for (int shift : {0, spec.velocityShift})
+    for (int first : spec.positionDofs)
+      for (int k = 0; k < 3; ++k) dofs.push_back(first + shift + k);
+  if (spec.branch)
+    for (std::size_t k = 0; k < 6 * spec.points.size(); ++k) dofs.push_back(spec.firstInternalDof + static_cast<int>(k));
+  return dofs;
+}
+
+// The branch stress of a strain A: lambda_v tr(A) I + 2 mu_v A (linear in A).
+Mat3 branchStressOf(const ViscousBranch& branch, const Mat3& strain) {
+  return branch.moduli.lambda * strain.trace() * Mat3::Identity() + 2 * branch.moduli.mu * strain;
+}
+
+double contract(const Mat3& a, const Mat3& b) { return (a.array() * b.array()).sum(); }
+}  // namespace
+
+// A quadrature point as one scheme sees it. EEM: forces at F_m with the discrete stress,
+// derivatives with respect to the end point (dF_m/dx' = 1/2, dE_m/dC' = 1/4, dGamma_m/dGamma'
+// = 1/2). Rate form: everything at z, tangent alpha d/dz + beta d/dzdot.
+struct SolidElement::PointEvaluation {
+  Mat3 forceGradient;          // F the forces act with
+  double forceGradientFactor;  // its derivative with respect to the end positions
+  Mat3 endGradient;            // F of the end positions the tangent differentiates
+  Mat3 stress;                 // total second Piola-Kirchhoff stress
+  Mat3 branchStress = Mat3::Zero();
+  double strainFactor = 0.0, gammaFactor = 0.0;  // dE/dC_end and dGamma/dGamma_end of the branch's argument
+  Mat3 gammaRate = Mat3::Zero();                 // (Gamma' - Gamma)/dt or dGamma/dt
+  double gammaRateCoefficient = 0.0;             // its derivative: 1/dt or beta
+  double tangentScale = 1.0;                     // 1 or alpha
+};
+
+SolidElement::SolidElement(SolidElementSpec spec)
+    : Component(spec.name, collectDofs(spec)), spec_(std::move(spec)), nodes_(static_cast<int>(spec_.positionDofs.size())) {}
+
+SolidElement::NodePositions SolidElement::positions(const double* z) const {
+  NodePositions x = NodePositions::Zero();
+  for (int a = 0; a < nodes_; ++a) x.col(a) = Eigen::Map<const Vec3>(z + spec_.positionDofs[a]);
+  return x;
+}
+
+Mat3 SolidElement::viscousStrain(const double* z, int point) const {
+  const double* g = z + spec_.firstInternalDof + 6 * point;
+  Mat3 gamma;
+  gamma << g[0], g[3], g[5], g[3], g[1], g[4], g[5], g[4], g[2];
+  return gamma;
+}
+
+void SolidElement::measure(const double* z, Measures& out) const {
+  const NodePositions x = positions(z);
+  for (std::size_t q = 0; q < spec_.points.size(); ++q) {
+    const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
+    double energy = spec_.material->energy(C);
+    if (spec_.branch) energy += spec_.branch->energy(C, viscousStrain(z, static_cast<int>(q)));
+    out.energy += spec_.points[q].weight * energy;
+  }
+}
+
+template <class MaterialIncrement>
+void SolidElement::assemblePoint(int q, const PointEvaluation& e, const MaterialIncrement& materialIncrement,
+                                 LocalSystem& out) const {
+  auto r = out.residual();
+  auto K = out.tangent();
+  const ShapeGradients& G = spec_.points[q].gradients;
+  const double w = spec_.points[q].weight, s = e.tangentScale;
+  const int momentumRow = 3 * nodes_, gammaRow = 6 * nodes_ + 6 * q;
+  const double fluidity = spec_.branch ? 1.0 / spec_.branch->viscosity : 0.0;
+
+  // nodal forces w F S dN_a/dX, and the branch's evolution rows
+  const Mat3 firstPiola = w * e.forceGradient * e.stress;
+  for (int a = 0; a < nodes_; ++a) r.segment<3>(momentumRow + 3 * a) += firstPiola * G.row(a).transpose();
+  if (spec_.branch)
+    for (int k = 0; k < 6; ++k) {
+      const auto [i, j] = kComponent[k];
+      r[gammaRow + k] = e.gammaRate(i, j) - fluidity * e.branchStress(i, j);
+    }
+
+  // columns of the end positions: dF = e_j dN_b/dX^T changes C by dF^T F + F^T dF
+  for (int b = 0; b < nodes_; ++b)
+    for (int j = 0; j < 3; ++j) {
+      Mat3 dF = Mat3::Zero();
+      dF.row(j) = G.row(b);
+      const Mat3 dC = dF.transpose() * e.endGradient + e.endGradient.transpose() * dF;
+      Mat3 dStress = materialIncrement(dC);
+      if (spec_.branch) {
+        const Mat3 dBranch = branchStressOf(*spec_.branch, e.strainFactor * dC);
+        dStress += dBranch;
+        for (int k = 0; k < 6; ++k) K(gammaRow + k, 3 * b + j) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+      }
+      const Mat3 dPiola = w * (e.forceGradientFactor * dF * e.stress + e.forceGradient * dStress);
+      for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, 3 * b + j) += s * dPiola * G.row(a).transpose();
+    }
+  if (!spec_.branch) return;
+
+  // columns of the viscous strain (a unit symmetric tensor per component)
+  for (int m = 0; m < 6; ++m) {
+    Mat3 dGamma = Mat3::Zero();
+    dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
+    const Mat3 dBranch = branchStressOf(*spec_.branch, -e.gammaFactor * dGamma);
+    const Mat3 dPiola = w * e.forceGradient * dBranch;
+    for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, gammaRow + m) += s * dPiola * G.row(a).transpose();
+    for (int k = 0; k < 6; ++k) K(gammaRow + k, gammaRow + m) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+    K(gammaRow + m, gammaRow + m) += e.gammaRateCoefficient;
+  }
+}
+
+void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  const NodePositions x0 = positions(args.zOld), x1 = positions(args.zNew);
+  for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
+    const ShapeGradients& G = spec_.points[q].gradients;
+    const Mat3 F0 = x0 * G, F1 = x1 * G;
+    const Mat3 C0 = F0.transpose() * F0, C1 = F1.transpose() * F1;
+    const DiscreteStress discrete(*spec_.material, C0, C1);
+    PointEvaluation e{0.5 * (F0 + F1), 0.5, F1, discrete.stress()};
+    e.strainFactor = 0.25;
+    e.gammaFactor = 0.5;
+    e.gammaRateCoefficient = 1.0 / args.dt;
+    if (spec_.branch) {
+      const Mat3 gamma0 = viscousStrain(args.zOld, q), gamma1 = viscousStrain(args.zNew, q);
+      e.branchStress = spec_.branch->stress(0.5 * (C0 + C1), 0.5 * (gamma0 + gamma1));
+      e.stress += e.branchStress;
+      e.gammaRate = (gamma1 - gamma0) / args.dt;
+      flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+    }
+    assemblePoint(q, e, [&](const Mat3& dC) { return discrete.increment(dC); }, out);
+  }
+}
+
+void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  const NodePositions x = positions(args.z);
+  for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
+    const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
+    PointEvaluation e{F, 1.0, F, spec_.material->stress(C)};
+    e.strainFactor = 0.5;
+    e.gammaFactor = 1.0;
+    e.gammaRateCoefficient = args.beta;
+    e.tangentScale = args.alpha;
+    if (spec_.branch) {
+      e.branchStress = spec_.branch->stress(C, viscousStrain(args.z, q));
+      e.stress += e.branchStress;
+      e.gammaRate = viscousStrain(args.zdot, q);
+      flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+    }
+    assemblePoint(q, e, [&](const Mat3& dC) { return spec_.material->stressIncrement(C, dC); }, out);
+  }
+}
+
+Mat3 SolidElement::meanCauchyStress(const double* z) const {
+  const NodePositions x = positions(z);
+  Mat3 sum = Mat3::Zero();
+  for (std::size_t q = 0; q < spec_.points.size(); ++q) {
+    const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
+    Mat3 S = spec_.material->stress(C);
+    if (spec_.branch) S += spec_.branch->stress(C, viscousStrain(z, static_cast<int>(q)));
+    sum += F * S * F.transpose() / F.determinant();
+  }
+  return sum / static_cast<double>(spec_.points.size());
+}
+
+Mat3 SolidElement::meanViscousStrain(const double* z) const {
+  Mat3 sum = Mat3::Zero();
+  if (!spec_.branch) return sum;
+  for (std::size_t q = 0; q < spec_.points.size(); ++q) sum += viscousStrain(z, static_cast<int>(q));
+  return sum / static_cast<double>(spec_.points.size());
+}
+
+}  // namespace mpx
