@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   run->add_option("--output-interval", request.frameInterval,
-                  "interval of bodies.csv and joints.csv rows (default: every history row)");
+                  "interval of bodies.csv and joints.csv rows and of solid frames (.vtu) (default: every history row)");
 
   CLI::App* compare = app.add_subcommand("compare", "run one scene with several integrators and tabulate "
                                                     "energy drift, entropy and cost side by side");

@@ -2,6 +2,7 @@
 #include "commands.hpp"
 #include "frames_csv.hpp"
 #include "history_csv.hpp"
+#include "solid_frames.hpp"
 
 #include "engine/input_error.hpp"
 #include "engine/method.hpp"
@@ -23,7 +24,7 @@ struct PreparedRun {
   CompiledScene scene;
   MethodParameters parameters;
   std::filesystem::path out;
-  double frameInterval = 0.0;  // bodies.csv / joints.csv
+  double frameInterval = 0.0;  // bodies.csv, joints.csv and solid frames
 };
 
 struct RunResult {
@@ -86,16 +87,19 @@ RunResult execute(const PreparedRun& run) {
   std::filesystem::create_directories(run.out);
   HistoryCsv history(run.out, *run.scene.model);
   FramesCsv frames(run.out, run.scene, run.frameInterval);
+  SolidFrames solids(run.out, run.scene, run.frameInterval);
   RunResult result{run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {},
                    history.path()};
   result.summary = runMethod(*run.scene.model, run.method, run.parameters,
                              [&](const StepRecord& r) {
                                history.write(r);
                                frames.write(r);
+                               solids.write(r);
                              },
                              progressBar(run.scene.settings.name + " " + run.method.name));
   history.finish(result.summary);
   frames.finish();
+  solids.finish();
   return result;
 }
 
