@@ -222,7 +222,8 @@ TEST_P(GonzalezStress, IsSymmetricInItsEndPoints) {
   }
 }
 
-// dS~/dC1 against central differences of S~ in C1, for increments above the switch and |dC| ~ 1e-7 below it.
+// dS~/dC1 against central differences of S~ in C1, for increments above the switch (down to |dC| ~ 1e-6) and
+// |dC| ~ 1e-9 below it.
 TEST_P(GonzalezStress, IncrementIsTheDerivativeInTheEndPoint) {
   const auto material = makeMaterial(GetParam());
   RandomMatrices random(23);
@@ -230,15 +231,31 @@ TEST_P(GonzalezStress, IncrementIsTheDerivativeInTheEndPoint) {
     double amplitude, step;
     bool belowSwitch;
   };
-  for (const Case& c : {Case{1.0, 1e-5, false}, Case{1e-2, 1e-5, false}, Case{1e-7, 2e-8, true}}) {
+  for (const Case& c : {Case{1.0, 1e-5, false}, Case{1e-2, 1e-5, false}, Case{1e-6, 1e-7, false},
+                        Case{1e-9, 1e-9, true}}) {
     const auto [C0, C1] = strainPair(random, c.amplitude);
-    ASSERT_EQ((C1 - C0).norm() <= kQuotientSwitch * std::max(C0.norm(), C1.norm()), c.belowSwitch);
+    ASSERT_EQ((C1 - C0).norm() <= kStressQuotientSwitch * std::max(C0.norm(), C1.norm()), c.belowSwitch);
     const Mat3 H = random.symmetric();
     const auto stressAt = [&](const Mat3& end) { return DiscreteStress(*material, C0, end).stress(); };
     const Mat3 fd = directionalDifference(stressAt, C1, H, c.step);
     const Mat3 exact = DiscreteStress(*material, C0, C1).increment(H);
     EXPECT_LT(relativeError(fd, exact), 1e-6) << "amplitude " << c.amplitude << ", |dC| " << (C1 - C0).norm();
   }
+}
+
+// The energy difference is free of cancellation: at |dC| = 1e-7 (above the switch) the Gonzalez correction stays
+// at its O(|dC|^2) size instead of round-off eps |W| / |dC|, and it matches W(C1) - W(C0) for a large increment.
+TEST_P(GonzalezStress, EnergyDifferenceHasNoCancellation) {
+  const auto material = makeMaterial(GetParam());
+  RandomMatrices random(29);
+  const auto [C0, C1] = strainPair(random, 1e-7);
+  const Mat3 correction = DiscreteStress(*material, C0, C1).stress() - material->stress(0.5 * (C0 + C1));
+  const double relative = correction.norm() / material->stress(0.5 * (C0 + C1)).norm();
+  std::printf("|dC| = %.1e: |S~ - S(Cm)| / |S| = %.2e\n", (C1 - C0).norm(), relative);
+  EXPECT_LT(relative, 1e-12);
+  const auto [D0, D1] = strainPair(random, 1.0);
+  const double direct = material->energy(D1) - material->energy(D0);
+  EXPECT_NEAR(material->energyDifference(D0, D1), direct, 1e-12 * std::abs(material->energy(D1)));
 }
 
 INSTANTIATE_TEST_SUITE_P(Laws, GonzalezStress, ::testing::Values(Law::SaintVenantKirchhoff, Law::NeoHooke));

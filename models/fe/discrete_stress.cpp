@@ -1,11 +1,11 @@
 #include "discrete_stress.hpp"
 
-#include "engine/discrete_gradient.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace mpx {
+
 
 DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1)
     : material_(&material),
@@ -13,12 +13,12 @@ DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3&
       delta_(C1 - C0),
       stress_(material.stress(midpoint_)),
       squaredDelta_(delta_.squaredNorm()),
-      tiny_(std::sqrt(squaredDelta_) <= kQuotientSwitch * std::max({C0.norm(), C1.norm(), 1.0})) {
+      tiny_(std::sqrt(squaredDelta_) <= kStressQuotientSwitch * std::max({C0.norm(), C1.norm(), 1.0})) {
   // below the switch the quotient would divide round-off by a tiny |dC|^2: keep the midpoint stress
   if (tiny_) return;
 
   // the Gonzalez correction along dC restores directionality; G uses A:dS[B] = B:dS[A] of hyperelastic tangents
-  const double defect = material.energy(C1) - material.energy(C0) - 0.5 * stress_.cwiseProduct(delta_).sum();
+  const double defect = material.energyDifference(C0, C1) - 0.5 * stress_.cwiseProduct(delta_).sum();
   kappa_ = defect / squaredDelta_;
   defectGradient_ = 0.5 * (material.stress(C1) - stress_) - 0.25 * material.stressIncrement(midpoint_, delta_);
   stress_ += 2.0 * kappa_ * delta_;

@@ -3,11 +3,18 @@
 // in the Frobenius metric (eem-primer.md section 2),
 //   S~ = S(Cm) + 2 [W(C1) - W(C0) - S(Cm):dC/2] dC / (dC:dC),  Cm = (C0 + C1)/2, dC = C1 - C0,
 // so that S~:(C1 - C0)/2 = W(C1) - W(C0) exactly (directionality); symmetric in (C0, C1), hence second order. Below
-// a relative increment |dC| <= kQuotientSwitch max(|C0|, |C1|, 1) (Frobenius norms) it is S(Cm). Also its
+// a relative increment |dC| <= 1e-8 max(|C0|, |C1|, 1) (Frobenius norms) it is S(Cm); W(C1) - W(C0)
+// comes from the material's cancellation-free energyDifference. Also its
 // derivative with respect to C1 for Newton's consistent tangent. Allocation-free: fixed-size matrices only.
 #include "models/fe/material.hpp"
 
 namespace mpx {
+
+// Relative |dC| below which S~ is the midpoint stress. The energy difference is free of
+// cancellation, so the quotient's round-off is eps |S| at any |dC| and its derivative's
+// eps |S| / |dC|; below 1e-8 the midpoint stress misses directionality by O(|dC|^2) = 1e-16.
+// (A switch at 1e-5 let Newton toggle between two stresses 1e-10 apart and stall.)
+inline constexpr double kStressQuotientSwitch = 1e-8;
 
 class DiscreteStress {
  public:

@@ -51,7 +51,36 @@ Mat3 SaintVenantKirchhoff::stressIncrement(const Mat3&, const Mat3& dC) const {
   return quadraticStress(lame_, 0.5 * dC);
 }
 
+// With A = E1 + E0 and dE = (C1 - C0)/2: lambda/2 tr(dE) tr(A) + mu dE:A.
+double SaintVenantKirchhoff::energyDifference(const Mat3& C0, const Mat3& C1) const {
+  const Mat3 strainSum = greenStrain(C0) + greenStrain(C1), strainDifference = 0.5 * (C1 - C0);
+  return 0.5 * lame_.lambda * strainDifference.trace() * strainSum.trace() +
+         lame_.mu * strainDifference.cwiseProduct(strainSum).sum();
+}
+
 NeoHooke::NeoHooke(LameParameters lame) : lame_(lame) {}
+
+namespace {
+// Adjugate of a 3 x 3 matrix: rows are cross products of its columns.
+Mat3 adjugate(const Mat3& m) {
+  Mat3 adj;
+  adj.row(0) = m.col(1).cross(m.col(2)).transpose();
+  adj.row(1) = m.col(2).cross(m.col(0)).transpose();
+  adj.row(2) = m.col(0).cross(m.col(1)).transpose();
+  return adj;
+}
+}  // namespace
+
+// ln J1 - ln J0 = ln(1 + (det C1 - det C0)/det C0)/2, the determinant difference expanded in
+// D = C1 - C0: det(C0 + D) - det C0 = tr(adj(C0) D) + tr(C0 adj(D)) + det D.
+double NeoHooke::energyDifference(const Mat3& C0, const Mat3& C1) const {
+  const Mat3 D = C1 - C0;
+  const double det0 = C0.determinant();
+  const double detDifference = (adjugate(C0) * D).trace() + (C0 * adjugate(D)).trace() + D.determinant();
+  if (!(det0 > 0.0) || !(det0 + detDifference > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  const double logJ0 = 0.5 * std::log(det0), logJChange = 0.5 * std::log1p(detDifference / det0);
+  return 0.5 * lame_.mu * D.trace() - lame_.mu * logJChange + 0.5 * lame_.lambda * logJChange * (2.0 * logJ0 + logJChange);
+}
 
 double NeoHooke::energy(const Mat3& C) const {
   const double logJ = logJacobian(C);

@@ -26,6 +26,9 @@ class HyperelasticMaterial {
   virtual Mat3 stress(const Mat3& C) const = 0;
   // directional derivative dS(C)[dC] (dC symmetric)
   virtual Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const = 0;
+  // W(C1) - W(C0) computed from C1 - C0 without cancellation: its error is round-off of the
+  // difference, not of W, which the Gonzalez quotient divides by |C1 - C0|^2.
+  virtual double energyDifference(const Mat3& C0, const Mat3& C1) const = 0;
 };
 
 // W = lambda/2 (tr E)^2 + mu E:E, E = (C - I)/2
@@ -35,6 +38,7 @@ class SaintVenantKirchhoff final : public HyperelasticMaterial {
   double energy(const Mat3& C) const override;
   Mat3 stress(const Mat3& C) const override;
   Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
+  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
 
  private:
   LameParameters lame_;
@@ -48,6 +52,7 @@ class NeoHooke final : public HyperelasticMaterial {
   double energy(const Mat3& C) const override;
   Mat3 stress(const Mat3& C) const override;
   Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
+  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
 
  private:
   LameParameters lame_;
