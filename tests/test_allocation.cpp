@@ -127,7 +127,8 @@ SteppingResult countStepLoopTraffic(const std::string& sceneFile, Scheme scheme)
 class StepLoopAllocation : public testing::TestWithParam<std::tuple<std::string, Scheme>> {};
 
 // Zero allocations and releases over 200 steps of every scheme on the thermo-mechanical
-// benchmark scenes (with heat links, internal variables and both thermal variables).
+// benchmark scenes (with heat links, internal variables and both thermal variables), a rigid
+// multibody scene and an FE solid (viscoelastic cells, joints to a body, gravity).
 TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
   const auto& [sceneFile, scheme] = GetParam();
   const SteppingResult result = countStepLoopTraffic(sceneFile, scheme);
@@ -138,7 +139,7 @@ TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
 
 INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,
                          testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
-                                                          "damped_double_pendulum.xml"),
+                                                          "damped_double_pendulum.xml", "flexible_pendulum.xml"),
                                           testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal)),
                          [](const testing::TestParamInfo<StepLoopAllocation::ParamType>& info) {
                            std::string scene = std::get<0>(info.param);
