@@ -13,6 +13,8 @@ class ExternalTorque final : public Component {
   // firstDirectorDof: global dof of d1 (d2, d3 follow); velocityShift: velocity dof - position dof.
   ExternalTorque(std::string name, int firstDirectorDof, int velocityShift, const Vec3& torque, TimeFunction profile);
 
+  // local order: 9 director positions, their 9 velocity rows; writes the velocity rows only
+  bool couples(int row, int) const override { return row >= 9; }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -35,6 +35,8 @@ class JointForce final : public Component {
  public:
   explicit JointForce(JointForceSpec spec);
 
+  // local order q, v, heat, internal: writes every row but the kinematic ones
+  bool couples(int row, int) const override { return row >= static_cast<int>(spec_.positionDofs.size()); }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -34,6 +34,11 @@ class TwoPointGeometry {
   void addSeparationTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDd) const;
   // Row over local dofs of d(w . d)/dz.
   void addSeparationRow(LocalRow& row, const Vec3& w) const;
+  // Whether local dof `local` is an end point's position (a row these elements never write).
+  bool isPosition(int local) const {
+    return (local >= localPositionA_ && local < localPositionA_ + 3 && localPositionA_ >= 0) ||
+           (local >= localPositionB_ && local < localPositionB_ + 3 && localPositionB_ >= 0);
+  }
 
  private:
   Endpoint a_, b_;

@@ -1,0 +1,421 @@
+// Finite-element solids under EEM: the assembled step tangent of one hexahedron against
+// central differences, the patch test and the balance of internal forces and moments, the
+// tumbling L-block (elastic and viscoelastic) keeping energy, E + dissipated and both momenta
+// where the midpoint rule does not, second order in time, the clamped viscoelastic cantilever,
+// the flexible pendulum on joints, and the velocity-condensed Newton solve against a plain LU.
+#include "support.hpp"
+#include "tangent_check.hpp"
+
+#include "models/fe/material.hpp"
+
+#include <Eigen/SparseLU>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace mpx::test {
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// ---------------------------------------------------------------------------------------------
+// Shared helpers: scenes from files with edits, runs, and drifts measured after the load.
+
+// A compiled scene with the run that integrated it (the history refers to the model).
+struct SceneRun {
+  CompiledScene scene;
+  History history;
+};
+
+// A run of `scene` from t = 0 to tEnd at step dt with the scene's Newton settings.
+SceneRun runScene(CompiledScene scene, Scheme scheme, double dt, double tEnd) {
+  History h = run(*scene.model, scheme, dt, tEnd, scene.settings.newton);
+  return {std::move(scene), std::move(h)};
+}
+
+// Index of the first recorded time at or after t.
+std::size_t indexAt(const History& h, double t) {
+  const auto it = std::lower_bound(h.time.begin(), h.time.end(), t - 1e-9);
+  return static_cast<std::size_t>(it - h.time.begin());
+}
+
+// max_{n >= from} |s_n - s_from| / scale
+double driftAfter(const std::vector<double>& series, std::size_t from, double scale) {
+  double drift = 0.0;
+  for (std::size_t n = from; n < series.size(); ++n) drift = std::max(drift, std::abs(series[n] - series[from]) / scale);
+  return drift;
+}
+
+double driftAfter(const std::vector<Vec3>& series, std::size_t from, double scale) {
+  double drift = 0.0;
+  for (std::size_t n = from; n < series.size(); ++n) drift = std::max(drift, (series[n] - series[from]).norm() / scale);
+  return drift;
+}
+
+// E + dissipated - external work - boundary heat of every recorded step.
+std::vector<double> energyBalance(const History& h) {
+  std::vector<double> balance;
+  for (std::size_t n = 0; n < h.energy.size(); ++n)
+    balance.push_back(h.energy[n] + h.dissipated[n] - h.externalWork[n] - h.boundaryHeat[n]);
+  return balance;
+}
+
+// Mass of the scene's first solid: the momentum of the state moving it at unit speed along x.
+double solidMass(const CompiledScene& scene) {
+  const SolidOutput& solid = scene.solids.front();
+  VectorXd z = scene.model->initialState();
+  z.segment(scene.model->layout().offset(Block::Velocity), scene.model->layout().size(Block::Velocity)).setZero();
+  for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n) z[solid.firstPositionDof + 3 * n + solid.velocityShift] = 1.0;
+  Measures measures;
+  scene.model->measure(z, measures);
+  return measures.momentum.x();
+}
+
+// Measures::constraintViolation (max |Phi|) of every recorded state.
+double maxViolation(const Model& model, const History& h) {
+  Measures measures;
+  double largest = 0.0;
+  for (const VectorXd& z : h.states) {
+    model.measure(z, measures);
+    largest = std::max(largest, measures.constraintViolation);
+  }
+  return largest;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. The assembled step tangent of one hexahedron (moving, deformed, with viscous strains)
+// against central differences of the step residual, for each law and scheme.
+struct CellCase {
+  const char* name;
+  const char* material;  // attributes of the <solid>
+  Scheme scheme;
+};
+
+void PrintTo(const CellCase& c, std::ostream* out) { *out << c.name << "_" << schemeName(c.scheme); }
+
+std::string oneCell(const CellCase& c) {
+  return std::string(R"(<metriplex name="one_cell"><simulation dt="0.1" t_end="10"/>
+    <solid name="cell" mesh="box" cells="1 1 1" young="1000" poisson="0.3" density="10" velocity="0.1 -0.2 0.3"
+           angular_velocity="0.5 0.2 -0.4" )") + c.material + "/></metriplex>";
+}
+
+class CellTangent : public ::testing::TestWithParam<CellCase> {};
+
+TEST_P(CellTangent, MatchesFiniteDifferencesAtAMovedState) {
+  const CompiledScene scene = loadSceneText(oneCell(GetParam()), GetParam().name);
+  const Model& model = *scene.model;
+  Integrator integrator(model, GetParam().scheme, NewtonSettings{});
+  // zOld deformed, moved and with viscous strains; zNew a generic step away from it
+  const VectorXd zOld = model.initialState() + 5e-2 * randomIsh(magnitudeAt(model, model.initialState()), 3);
+  const VectorXd zNew = zOld + 1e-2 * randomIsh(magnitudeAt(model, zOld), 5);
+  const double t = 0.7, dt = 0.1;
+  const MatrixXd analytic(integrator.evaluate(zOld, zNew, t, dt).tangent());
+  const auto residual = [&](const VectorXd& z) -> VectorXd { return integrator.evaluate(zOld, z, t, dt).residual(); };
+  const VectorXd magnitude = magnitudeAt(model, zNew);
+  const MatrixXd numeric = centralDifferences(residual, zNew, magnitude, 1e-6);
+  const Mismatch worst = worstRowMismatch(analytic, numeric, magnitude);
+  std::printf("hex8 %s, %s: worst relative tangent mismatch %.2e (row %ld, column %ld)\n", GetParam().name,
+              schemeName(GetParam().scheme).c_str(), worst.relative, static_cast<long>(worst.row),
+              static_cast<long>(worst.col));
+  expectTangentMatches(model, analytic, numeric, magnitude, 1e-6);
+}
+
+std::vector<CellCase> cellCases() {
+  const std::pair<const char*, const char*> laws[] = {
+      {"svk", R"(material="svk")"},
+      {"neo_hooke", R"(material="neo_hooke")"},
+      {"neo_hooke_viscous", R"(material="neo_hooke" branch_lambda="200" branch_mu="50" viscosity="100")"}};
+  std::vector<CellCase> cases;
+  for (const auto& [name, material] : laws)
+    for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint}) cases.push_back({name, material, scheme});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryLaw, CellTangent, ::testing::ValuesIn(cellCases()),
+                         [](const ::testing::TestParamInfo<CellCase>& info) {
+                           return std::string(info.param.name) + "_" + schemeName(info.param.scheme);
+                         });
+
+// ---------------------------------------------------------------------------------------------
+// 2. Internal nodal forces: the momentum rows of the EEM residual at rest (zOld = zNew, v = 0,
+// no loads), which are exactly sum_q w F S dN_a/dX there.
+constexpr double kYoung = 1000.0, kPoisson = 0.3;
+
+const char* const kCube = R"(<metriplex name="cube"><simulation dt="0.1" t_end="1"/>
+  <solid name="cube" mesh="box" size="2 2 2" cells="2 2 2" material="neo_hooke" young="1000" poisson="0.3"
+         density="10"/></metriplex>)";
+
+// Node n's internal force in state z (velocities zeroed): its momentum rows at rest.
+std::vector<Vec3> internalForces(const CompiledScene& scene, VectorXd z) {
+  const Model& model = *scene.model;
+  z.segment(model.layout().offset(Block::Velocity), model.layout().size(Block::Velocity)).setZero();
+  Integrator integrator(model, Scheme::Eem, NewtonSettings{});
+  const VectorXd& r = integrator.evaluate(z, z, 0.0, 0.1).residual();
+  const SolidOutput& solid = scene.solids.front();
+  std::vector<Vec3> forces;
+  for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n)
+    forces.push_back(r.segment<3>(solid.firstPositionDof + 3 * n + solid.velocityShift));
+  return forces;
+}
+
+// The state with node n at x(X_n).
+template <class Map>
+VectorXd deformed(const CompiledScene& scene, const Map& map) {
+  const SolidOutput& solid = scene.solids.front();
+  VectorXd z = scene.model->initialState();
+  for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n)
+    z.segment<3>(solid.firstPositionDof + 3 * n) = map(solid.mesh->nodes[n]);
+  return z;
+}
+
+// Under x = A X + b the stress P = A S(A^T A) is uniform, so node a's force is the traction
+// of P on the boundary, P sum_faces int N_a N dA (a quarter of each rectangular face's area
+// vector), and the one interior node, (1, 1, 1), carries none.
+TEST(InternalForces, PassThePatchTestUnderAHomogeneousDeformation) {
+  const CompiledScene scene = loadSceneText(kCube, "cube");
+  const Mesh& mesh = *scene.solids.front().mesh;
+  Mat3 A;
+  A << 1.05, 0.02, -0.03, -0.04, 0.97, 0.01, 0.02, 0.05, 1.08;
+  const Vec3 b(0.3, -0.2, 0.1);
+  const std::vector<Vec3> forces = internalForces(scene, deformed(scene, [&](const Vec3& X) { return Vec3(A * X + b); }));
+
+  const Mat3 P = A * NeoHooke(LameParameters::fromYoung(kYoung, kPoisson)).stress(A.transpose() * A);
+  std::vector<Vec3> expected(mesh.nodes.size(), Vec3::Zero());
+  for (const Face& face : mesh.boundaryFaces()) {
+    const auto& x = mesh.nodes;
+    const Vec3 areaVector = (x[face.nodes[1]] - x[face.nodes[0]]).cross(x[face.nodes[3]] - x[face.nodes[0]]);
+    for (int a = 0; a < face.count; ++a) expected[face.nodes[a]] += P * areaVector / 4;
+  }
+  const double scale = P.norm() * 1.0;  // stress times a cell face's area
+  double worst = 0.0, interior = -1.0;
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    worst = std::max(worst, (forces[n] - expected[n]).norm() / scale);
+    if ((mesh.nodes[n] - Vec3::Ones()).norm() < 1e-12) interior = forces[n].norm() / scale;
+  }
+  std::printf("patch test, |P| = %.3g: interior node |f| %.2e, worst |f - traction load| %.2e (relative to |P| A)\n",
+              P.norm(), interior, worst);
+  ASSERT_GE(interior, 0.0) << "no node at (1, 1, 1)";
+  EXPECT_LE(interior, 1e-12);
+  EXPECT_LE(worst, 1e-12);
+}
+
+// F S F^T is symmetric at every point: the internal forces of any deformation sum to zero
+// and exert no moment (the balance EEM's momentum conservation rests on).
+TEST(InternalForces, HaveNoResultantForceOrMomentInAGeneralDeformation) {
+  const CompiledScene scene = loadSceneText(kCube, "cube");
+  const VectorXd z = deformed(scene, [](const Vec3& X) {
+    return Vec3(X.x() + 0.1 * std::sin(X.y()) + 0.5, X.y() + 0.08 * X.x() * X.z(), X.z() - 0.05 * X.y() * X.y());
+  });
+  const std::vector<Vec3> forces = internalForces(scene, z);
+  const SolidOutput& solid = scene.solids.front();
+  Vec3 resultant = Vec3::Zero(), moment = Vec3::Zero();
+  double largest = 0.0, reach = 0.0;
+  for (std::size_t n = 0; n < forces.size(); ++n) {
+    const Vec3 x = z.segment<3>(solid.firstPositionDof + 3 * n);
+    resultant += forces[n];
+    moment += x.cross(forces[n]);
+    largest = std::max(largest, forces[n].norm());
+    reach = std::max(reach, x.norm());
+  }
+  std::printf("general deformation, largest |f_a| %.3g: |sum f_a| %.2e, |sum x_a x f_a| %.2e (relative)\n", largest,
+              resultant.norm() / largest, moment.norm() / (largest * reach));
+  EXPECT_GT(largest, 1.0);  // the deformation does load the nodes
+  EXPECT_LE(resultant.norm(), 1e-13 * largest);
+  EXPECT_LE(moment.norm(), 1e-13 * largest * reach);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3, 4. The tumbling L-blocks: dead tractions with the hat profile for t <= 5, free after.
+constexpr double kLoadEnd = 5.0;
+
+// The conserved figures of a run after the load: energy (or E + dissipated - work, which is 0
+// from rest) relative to E(5), P against the momentum scale sqrt(2 m E(5)), J relative to |J(5)|.
+struct AfterLoad {
+  double energy, momentum, angularMomentum;
+};
+
+AfterLoad driftsAfterLoad(const SceneRun& r, const std::vector<double>& conserved) {
+  const History& h = r.history;
+  const std::size_t from = indexAt(h, kLoadEnd);
+  const double momentumScale = std::sqrt(2.0 * solidMass(r.scene) * h.energy[from]);
+  return {driftAfter(conserved, from, h.energy[from]), driftAfter(h.momentum, from, momentumScale),
+          driftAfter(h.angularMomentum, from, h.angularMomentum[from].norm())};
+}
+
+TEST(TumblingLBlock, EemConservesEnergyAndMomentaWhereMidpointDoesNot) {
+  const SceneRun eem = runScene(loadScene(scenePath("lblock_elastic.xml")), Scheme::Eem, 0.1, 50.0);
+  ASSERT_FALSE(eem.history.summary.failed) << eem.history.summary.failure;
+  const AfterLoad drift = driftsAfterLoad(eem, eem.history.energy);
+  std::printf("elastic L-block, EEM dt 0.1, t 5..50: drift of E %.2e, P %.2e, J %.2e\n", drift.energy, drift.momentum,
+              drift.angularMomentum);
+  EXPECT_LE(drift.energy, 1e-9);
+  EXPECT_LE(drift.momentum, 1e-9);
+  EXPECT_LE(drift.angularMomentum, 1e-9);
+
+  const SceneRun midpoint = runScene(loadScene(scenePath("lblock_elastic.xml")), Scheme::Midpoint, 0.1, 20.0);
+  const History& m = midpoint.history;
+  if (m.summary.failed) {
+    std::printf("elastic L-block, midpoint dt 0.1: failed at step %d (t = %g): %s\n", m.summary.failedStep,
+                m.summary.failedTime, m.summary.failure.c_str());
+    return;
+  }
+  const double midpointDrift = driftAfter(m.energy, indexAt(m, kLoadEnd), m.energy[indexAt(m, kLoadEnd)]);
+  std::printf("elastic L-block, midpoint dt 0.1, t 5..20: drift of E %.2e (%.0fx EEM's over t 5..50)\n", midpointDrift,
+              midpointDrift / drift.energy);
+  EXPECT_GE(midpointDrift, 100.0 * drift.energy);
+}
+
+TEST(ViscoelasticLBlock, EemKeepsEnergyPlusDissipationAndMomentaWhileEnergyDecays) {
+  const SceneRun r = runScene(loadScene(scenePath("lblock_viscoelastic.xml")), Scheme::Eem, 0.25, 20.0);
+  const History& h = r.history;
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const AfterLoad drift = driftsAfterLoad(r, energyBalance(h));
+  // steps after the load: E never rises, dissipated energy never falls (up to round-off)
+  const std::size_t from = indexAt(h, kLoadEnd);
+  double largestRise = -INFINITY, largestFall = -INFINITY;
+  for (std::size_t n = from + 1; n < h.energy.size(); ++n) {
+    largestRise = std::max(largestRise, (h.energy[n] - h.energy[n - 1]) / h.energy[from]);
+    largestFall = std::max(largestFall, (h.dissipated[n - 1] - h.dissipated[n]) / h.energy[from]);
+  }
+  std::printf("viscoelastic L-block, EEM dt 0.25, t 5..20: drift of E + D %.2e, P %.2e, J %.2e; E fell to %.3f E(5); "
+              "largest step rise of E %.2e, fall of D %.2e\n",
+              drift.energy, drift.momentum, drift.angularMomentum, h.energy.back() / h.energy[from], largestRise,
+              largestFall);
+  EXPECT_LE(drift.energy, 1e-9);
+  EXPECT_LE(drift.momentum, 1e-9);
+  EXPECT_LE(drift.angularMomentum, 1e-9);
+  EXPECT_LE(largestRise, 1e-12);
+  EXPECT_LE(largestFall, 1e-12);
+  EXPECT_LT(h.energy.back(), 0.9 * h.energy[from]);  // the branch does dissipate
+}
+
+// ---------------------------------------------------------------------------------------------
+// 5. Second order in time: the L-block under its load up to t = 1, dt = 0.05 halved four times.
+// The differences of successive final positions (Euclidean norm) fall by 4 per halving for a
+// second-order scheme: a Richardson estimate of the error that needs no reference run. The
+// L-block's stiff modes keep dt = 0.1 outside the asymptotic range (slope 1.7 there).
+class TimeOrder : public ::testing::TestWithParam<Scheme> {};
+
+TEST_P(TimeOrder, IsTwoOnTheLoadedLBlock) {
+  const CompiledScene scene = loadScene(scenePath("lblock_elastic.xml"));
+  const int positions = scene.model->layout().size(Block::Position);
+  std::vector<VectorXd> finals;
+  for (double dt = 0.05; dt > 0.003; dt /= 2) {
+    const History h = run(*scene.model, GetParam(), dt, 1.0, scene.settings.newton);
+    ASSERT_FALSE(h.summary.failed) << "dt " << dt << ": " << h.summary.failure;
+    finals.push_back(h.states.back().head(positions));
+  }
+  std::vector<double> differences;
+  for (std::size_t k = 0; k + 1 < finals.size(); ++k) differences.push_back((finals[k] - finals[k + 1]).norm());
+  std::string table;
+  for (std::size_t k = 0; k + 1 < differences.size(); ++k) {
+    const double slope = std::log2(differences[k] / differences[k + 1]);
+    table += (k ? ", " : "") + std::to_string(slope).substr(0, 5);
+    EXPECT_GE(slope, 1.8) << "halving " << k;
+    EXPECT_LE(slope, 2.2) << "halving " << k;
+  }
+  std::printf("L-block to t = 1, %s, dt 0.05 ... 0.003125: |x(dt) - x(dt/2)| from %.3e to %.3e, slopes %s\n",
+              schemeName(GetParam()).c_str(), differences.front(), differences.back(), table.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(EemAndMidpoint, TimeOrder, ::testing::Values(Scheme::Eem, Scheme::Midpoint),
+                         [](const ::testing::TestParamInfo<Scheme>& info) { return schemeName(info.param); });
+
+// ---------------------------------------------------------------------------------------------
+// 6. The viscoelastic cantilever, pulled for t <= 5 and relaxing after: its clamped face
+// stays put and E + D - W is exact.
+TEST(ViscoelasticCantilever, ClampHoldsAndEnergyBalanceIsExactWhileItRelaxes) {
+  const SceneRun r = runScene(loadScene(scenePath("viscoelastic_cantilever.xml")), Scheme::Eem, 0.02, 6.0);
+  const History& h = r.history;
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const SolidOutput& bar = r.scene.solids.front();
+  double clampMotion = 0.0;
+  for (const VectorXd& z : h.states)
+    for (int n : bar.mesh->nodesOf("x0"))
+      clampMotion = std::max(clampMotion, (z.segment<3>(bar.firstPositionDof + 3 * n) - bar.mesh->nodes[n]).norm());
+  const std::vector<double> balance = energyBalance(h);
+  const double peak = *std::max_element(h.energy.begin(), h.energy.end());
+  const double scale = std::max({peak, h.dissipated.back(), std::abs(h.externalWork.back())});
+  const double balanceError = driftAfter(balance, 0, scale);
+  const double atLoadEnd = h.energy[indexAt(h, kLoadEnd)];
+  std::printf("cantilever, EEM dt 0.02 to t = 6: clamp moved %.2e; |E + D - W - E0| %.2e of %.3g; E(6) = %.3f peak, "
+              "%.3f E(5); W = %.3g, D = %.3g\n",
+              clampMotion, balanceError, scale, h.energy.back() / peak, h.energy.back() / atLoadEnd,
+              h.externalWork.back(), h.dissipated.back());
+  EXPECT_LE(clampMotion, 1e-14);
+  EXPECT_LE(balanceError, 1e-9);
+  EXPECT_LT(h.energy.back(), atLoadEnd);  // relaxing once the pull stops
+  EXPECT_GT(h.dissipated.back(), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 7. The flexible pendulum: a viscoelastic FE link on a hub, released from rest (E0 = 0).
+// The balance is judged against the link's potential scale m g L (m = 8, L = 2).
+TEST(FlexiblePendulum, EnergyBalanceAndJointsHoldToRoundOff) {
+  const SceneRun r = runScene(loadScene(scenePath("flexible_pendulum.xml")), Scheme::Eem, 0.005, 0.5);
+  const History& h = r.history;
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const double potentialScale = 8.0 * 9.81 * 2.0;
+  const double balanceError = driftAfter(energyBalance(h), 0, potentialScale);
+  const double violation = maxViolation(*r.scene.model, h);
+  // how far the free end (x = 2) fell: the link did swing
+  const SolidOutput& link = r.scene.solids.front();
+  const int tipY = link.firstPositionDof + 3 * link.mesh->nodesOf("x1").front() + 1;
+  const double drop = h.states.front()[tipY] - h.states.back()[tipY];
+  std::printf("flexible pendulum, EEM dt 0.005 to t = 0.5: |E + D - E0| %.2e m g L, max constraint violation %.2e; "
+              "tip fell %.3f, D = %.3g\n",
+              balanceError, violation, drop, h.dissipated.back());
+  EXPECT_LE(balanceError, 1e-9);
+  EXPECT_LE(violation, 1e-9);
+  EXPECT_GT(drop, 0.1);
+  EXPECT_GT(h.dissipated.back(), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 8. The velocity-condensed Newton solve against a plain sparse LU of the whole tangent, at a
+// generic step of the elastic and the viscoelastic L-block, for EEM and midpoint.
+class CondensedNewton : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
+  const CompiledScene scene = loadScene(scenePath(GetParam()));
+  const Model& model = *scene.model;
+  const Layout& layout = model.layout();
+  const VectorXd zOld = model.initialState() + 1e-2 * randomIsh(magnitudeAt(model, model.initialState()), 17);
+  const VectorXd zNew = zOld + 1e-2 * randomIsh(magnitudeAt(model, zOld), 19);
+  const VectorXd weight = magnitudeAt(model, zNew).cwiseInverse();
+  for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint}) {
+    Integrator integrator(model, scheme, scene.settings.newton);
+    const Assembler& system = integrator.evaluate(zOld, zNew, 2.0, 0.1);
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    lu.compute(system.tangent());
+    ASSERT_EQ(lu.info(), Eigen::Success) << lu.lastErrorMessage();
+    const VectorXd plain = -lu.solve(system.residual());
+
+    CondensedSolver condensed(layout, system.tangent());
+    ASSERT_TRUE(condensed.factorize(system.tangent(), false));
+    VectorXd increment(layout.total());
+    condensed.solve(system.residual(), increment);
+    // every dof weighed by its magnitude, so that positions and velocities compare alike
+    const double difference = (increment - plain).cwiseProduct(weight).cwiseAbs().maxCoeff() /
+                              plain.cwiseProduct(weight).cwiseAbs().maxCoeff();
+    std::printf("%s, %s: condensed %d of %d unknowns, relative difference to plain LU %.2e\n", GetParam(),
+                schemeName(scheme).c_str(), condensed.condensedSize(), layout.total(), difference);
+    EXPECT_EQ(condensed.condensedSize(), layout.total() - layout.size(Block::Velocity));
+    EXPECT_LE(difference, 1e-9);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(LBlocks, CondensedNewton, ::testing::Values("lblock_elastic.xml", "lblock_viscoelastic.xml"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           const std::string file = info.param;
+                           return file.substr(0, file.find('.'));
+                         });
+
+}  // namespace
+}  // namespace mpx::test

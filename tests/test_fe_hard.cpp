@@ -1,0 +1,82 @@
+// Hard cases for the finite-element solids: the tumbling L-block at steps where the implicit
+// midpoint rule blows up or fails while EEM keeps the energy, and the nearly incompressible
+// L-block (Poisson 0.495), whose stiff volumetric response EEM carries through every step.
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mpx::test {
+namespace {
+
+constexpr double kLoadEnd = 5.0;  // the L-block's tractions act for t <= 5
+
+// max |E_n - E(5)| / |E(5)| over the recorded steps from t = 5 on; infinite if the run never
+// got past the load.
+double energyDriftAfterLoad(const History& h) {
+  const auto from = static_cast<std::size_t>(std::lower_bound(h.time.begin(), h.time.end(), kLoadEnd - 1e-9) - h.time.begin());
+  if (from >= h.energy.size()) return INFINITY;
+  double drift = 0.0;
+  for (std::size_t n = from; n < h.energy.size(); ++n)
+    drift = std::max(drift, std::abs(h.energy[n] - h.energy[from]) / std::abs(h.energy[from]));
+  return drift;
+}
+
+// 9. Midpoint and EEM on the elastic L-block over t <= 50 at growing steps. Midpoint breaks
+// (energy off by more than 10% after the load, or Newton fails) at some of them; EEM keeps
+// the energy at every step it is asked to take.
+TEST(TumblingLBlockHard, EemKeepsTheEnergyAtStepsWhereMidpointBlowsUp) {
+  const CompiledScene scene = loadScene(scenePath("lblock_elastic.xml"));
+  const Model& model = *scene.model;
+  int broken = 0;
+  std::printf("elastic L-block to t = 50, energy error after the load:\n    dt   %-34s   EEM\n", "midpoint");
+  for (double dt : {0.25, 0.5, 1.0, 2.0}) {
+    const History midpoint = run(model, Scheme::Midpoint, dt, 50.0, scene.settings.newton);
+    const double midpointDrift = energyDriftAfterLoad(midpoint);
+    const History eem = run(model, Scheme::Eem, dt, 50.0, scene.settings.newton);
+    const double eemDrift = eem.summary.failed ? INFINITY : energyDriftAfterLoad(eem);
+    char midpointColumn[64];
+    if (midpoint.summary.failed)
+      std::snprintf(midpointColumn, sizeof midpointColumn, "failed at step %d (t = %g)", midpoint.summary.failedStep,
+                    midpoint.summary.failedTime);
+    else
+      std::snprintf(midpointColumn, sizeof midpointColumn, "%.2e", midpointDrift);
+    std::printf("%6.2f   %-34s   %.2e%s\n", dt, midpointColumn, eemDrift, eem.summary.failed ? " (EEM failed)" : "");
+    EXPECT_FALSE(eem.summary.failed) << "dt " << dt << ": " << eem.summary.failure;
+    EXPECT_LE(eemDrift, 1e-8) << "dt " << dt;
+    if (midpoint.summary.failed || !(midpointDrift <= 0.1)) ++broken;
+  }
+  EXPECT_GT(broken, 0) << "midpoint kept the energy to 10% at every step tried";
+}
+
+// 10. Poisson 0.495 (lambda = 99 mu): EEM at dt 0.1 converges at every step and keeps the
+// energy after the load.
+TEST(NearlyIncompressibleLBlock, EemConvergesEveryStepAndKeepsTheEnergy) {
+  std::ifstream in(scenePath("lblock_elastic.xml"));
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string from = R"(poisson="0.395469")";
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << "the scene no longer declares " << from;
+  text.replace(at, from.size(), R"(poisson="0.495")");
+  const CompiledScene scene = loadSceneText(text, "lblock_incompressible");
+  const History h = run(*scene.model, Scheme::Eem, 0.1, 10.0, scene.settings.newton);
+  const double drift = energyDriftAfterLoad(h);
+  std::printf("L-block, Poisson 0.495, EEM dt 0.1 to t = 10: %d steps, %.2f Newton iterations per step, %d cut-backs; "
+              "E drift after the load %.2e\n",
+              h.summary.steps, static_cast<double>(h.summary.newtonIterations) / std::max(1, h.summary.steps),
+              h.summary.cutbacks, drift);
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  EXPECT_EQ(h.summary.steps, 100);
+  EXPECT_LE(drift, 1e-8);
+}
+
+}  // namespace
+}  // namespace mpx::test
