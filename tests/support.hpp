@@ -46,4 +46,10 @@ inline History run(const Model& model, Scheme scheme, double dt, double tEnd, Ne
   return h;
 }
 
+// A compiled scene with the run that integrated it (the history refers to the model).
+struct SceneRun {
+  CompiledScene scene;
+  History history;
+};
+
 }  // namespace mpx::test

@@ -28,12 +28,6 @@ using Eigen::VectorXd;
 // ---------------------------------------------------------------------------------------------
 // Shared helpers: scenes from files with edits, runs, and drifts measured after the load.
 
-// A compiled scene with the run that integrated it (the history refers to the model).
-struct SceneRun {
-  CompiledScene scene;
-  History history;
-};
-
 // A run of `scene` from t = 0 to tEnd at step dt with the scene's Newton settings.
 SceneRun runScene(CompiledScene scene, Scheme scheme, double dt, double tEnd) {
   History h = run(*scene.model, scheme, dt, tEnd, scene.settings.newton);
@@ -76,6 +70,15 @@ double solidMass(const CompiledScene& scene) {
   Measures measures;
   scene.model->measure(z, measures);
   return measures.momentum.x();
+}
+
+// Largest distance of the nodes of a solid's surface from their reference positions.
+double largestMotion(const std::vector<VectorXd>& states, const SolidOutput& solid, const std::string& surface) {
+  double motion = 0.0;
+  for (const VectorXd& z : states)
+    for (int n : solid.mesh->nodesOf(surface))
+      motion = std::max(motion, (z.segment<3>(solid.firstPositionDof + 3 * n) - solid.mesh->nodes[n]).norm());
+  return motion;
 }
 
 // Measures::constraintViolation (max |Phi|) of every recorded state.
@@ -343,10 +346,7 @@ TEST(ViscoelasticCantilever, ClampHoldsAndEnergyBalanceIsExactWhileItRelaxes) {
   const History& h = r.history;
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
   const SolidOutput& bar = r.scene.solids.front();
-  double clampMotion = 0.0;
-  for (const VectorXd& z : h.states)
-    for (int n : bar.mesh->nodesOf("x0"))
-      clampMotion = std::max(clampMotion, (z.segment<3>(bar.firstPositionDof + 3 * n) - bar.mesh->nodes[n]).norm());
+  const double clampMotion = largestMotion(h.states, bar, "x0");
   const std::vector<double> balance = energyBalance(h);
   const double peak = *std::max_element(h.energy.begin(), h.energy.end());
   const double scale = std::max({peak, h.dissipated.back(), std::abs(h.externalWork.back())});
@@ -369,10 +369,7 @@ TEST(TetrahedralBar, ClampHoldsAndEnergyMinusWorkIsExact) {
   const History& h = r.history;
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
   const SolidOutput& bar = r.scene.solids.front();
-  double clampMotion = 0.0;
-  for (const VectorXd& z : h.states)
-    for (int n : bar.mesh->nodesOf("left"))
-      clampMotion = std::max(clampMotion, (z.segment<3>(bar.firstPositionDof + 3 * n) - bar.mesh->nodes[n]).norm());
+  const double clampMotion = largestMotion(h.states, bar, "left");
   const double scale = *std::max_element(h.externalWork.begin(), h.externalWork.end());
   const double balanceError = driftAfter(energyBalance(h), 0, scale);
   std::printf("tet bar (%zu tets), EEM dt 0.01 to t = 1.5: clamp moved %.2e; |E - W - E0| %.2e of W = %.3g\n",
@@ -396,10 +393,7 @@ TEST(TetrahedralBar, IdaHoldsTheClampAndFollowsEem) {
   ASSERT_FALSE(summary.failed) << summary.failure;
   const History eem = run(*scene.model, Scheme::Eem, 1e-3, 1.0, scene.settings.newton);
   const SolidOutput& bar = scene.solids.front();
-  double clampMotion = 0.0;
-  for (const VectorXd& z : ida)
-    for (int n : bar.mesh->nodesOf("left"))
-      clampMotion = std::max(clampMotion, (z.segment<3>(bar.firstPositionDof + 3 * n) - bar.mesh->nodes[n]).norm());
+  const double clampMotion = largestMotion(ida, bar, "left");
   const int tip = bar.firstPositionDof + 3 * bar.mesh->nodesOf("right").front();
   const Vec3 idaTip = ida.back().segment<3>(tip), eemTip = eem.states.back().segment<3>(tip);
   const double deflection = (eemTip - bar.mesh->nodes[bar.mesh->nodesOf("right").front()]).norm();

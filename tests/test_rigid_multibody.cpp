@@ -21,12 +21,6 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// A compiled scene with the run that integrated it (the history refers to the model).
-struct SceneRun {
-  CompiledScene scene;
-  History history;
-};
-
 // `steps` steps of the scene's own dt with the scene's Newton settings.
 SceneRun runSteps(CompiledScene scene, Scheme scheme, int steps) {
   const SceneSettings& s = scene.settings;
