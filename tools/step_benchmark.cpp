@@ -1,11 +1,15 @@
 // metriplex_step_benchmark: cost of one integrator step along a real trajectory (time, Newton
-// iterations, cut-backs) for the benchmark scenes and generated chains of thermo-springs and of
-// rigid links.
+// iterations, cut-backs) for the benchmark scenes, generated chains of thermo-springs and of
+// rigid links, and the tumbling L-block by mesh level (with the step split into assembly and
+// linear solve).
 // Reproduce and read the figures with docs/performance.md.
+#include "engine/condensed_solver.hpp"
+#include "engine/integrator.hpp"
 #include "models/scene/scene_loader.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <initializer_list>
@@ -83,30 +87,98 @@ std::string rigidChainXml(int links, const std::string& enforcement, double stif
   return xml.str();
 }
 
-// Time per step of `scheme` at the scene's dt, stepping on from the previous state so every
-// iteration is a step of one trajectory; the integrator and both states exist before timing.
-void stepBenchmark(benchmark::State& state, const std::shared_ptr<const CompiledScene>& scene, Scheme scheme) {
-  const Model& model = *scene->model;
-  const double dt = scene->settings.dt;
-  Integrator integrator(model, scheme, scene->settings.newton);
-  Eigen::VectorXd z = model.initialState(), zNext(z.size());
-  double t = 0.0;
-  long newtonIterations = 0, cutbacks = 0;
-  for (auto _ : state) {
-    const StepOutcome outcome = integrator.advance(z, t, dt, zNext);
+// The tumbling L-block of scenes/lblock_elastic.xml (Neo-Hooke, two opposite dead tractions
+// with the hat profile of period 5) on mesh level `level`; `viscous` adds the Maxwell branch
+// of scenes/lblock_viscoelastic.xml.
+std::string lblockXml(int level, bool viscous, double dt) {
+  std::ostringstream xml;
+  xml << "<metriplex name=\"lblock\">\n"
+      << "  <simulation dt=\"" << dt << "\" t_end=\"50\"/>\n"
+      << "  <solid name=\"block\" mesh=\"lblock\" level=\"" << level << "\" material=\"neo_hooke\""
+      << " young=\"2.26115e3\" poisson=\"0.395469\" density=\"10\"";
+  if (viscous) xml << " branch_lambda=\"227.2\" branch_mu=\"49.875\" viscosity=\"100\"";
+  xml << "/>\n"
+      << "  <traction name=\"push_top\" solid=\"block\" surface=\"load_y10\" total_force=\"256 512 768\""
+      << " profile=\"hat\" period=\"5\"/>\n"
+      << "  <traction name=\"push_side\" solid=\"block\" surface=\"load_x6\" total_force=\"-256 -512 -768\""
+      << " profile=\"hat\" period=\"5\"/>\n"
+      << "</metriplex>\n";
+  return xml.str();
+}
+
+// One trajectory of a scene at a fixed dt: each step advances z at time t into zNext, which
+// then becomes z. The integrator and both states exist before any step is timed.
+class Trajectory {
+ public:
+  Trajectory(const CompiledScene& scene, Scheme scheme, Eigen::VectorXd z, double t, double dt)
+      : dt_(dt), integrator_(*scene.model, scheme, scene.settings.newton), z_(std::move(z)),
+        zNext_(z_.size()), t_(t) {}
+
+  // One step; false (see failure()) if Newton failed after all cut-backs.
+  bool step() {
+    const StepOutcome outcome = integrator_.advance(z_, t_, dt_, zNext_);
     if (!outcome.converged) {
-      state.SkipWithError(("step failed at t = " + std::to_string(t) + ": " + outcome.failure).c_str());
+      failure_ = "step failed at t = " + std::to_string(t_) + ": " + outcome.failure;
+      return false;
+    }
+    newtonIterations_ += outcome.iterations;
+    cutbacks_ += outcome.cutbacks;
+    z_.swap(zNext_);
+    t_ += dt_;
+    return true;
+  }
+  // Start again from z at time t with steps of dt (the integrator, its LU analysed, is kept).
+  void restart(const Eigen::VectorXd& z, double t, double dt) {
+    z_ = z;
+    t_ = t;
+    dt_ = dt;
+    newtonIterations_ = cutbacks_ = 0;
+    failure_.clear();
+  }
+  // Step on until t reaches `until` (within half a step).
+  bool stepTo(double until) {
+    while (t_ < until - 0.5 * dt_)
+      if (!step()) return false;
+    return true;
+  }
+
+  // Newton iterations and cut-backs per benchmark iteration (one step each), the state's size
+  // and how far the trajectory got.
+  void report(benchmark::State& state) const {
+    state.counters["newton_per_step"] = benchmark::Counter(newtonIterations_, benchmark::Counter::kAvgIterations);
+    state.counters["cutbacks_per_step"] = benchmark::Counter(cutbacks_, benchmark::Counter::kAvgIterations);
+    state.counters["dofs"] = static_cast<double>(z_.size());
+    state.counters["t_reached"] = t_;
+  }
+
+  Integrator& integrator() { return integrator_; }
+  const Eigen::VectorXd& state() const { return z_; }
+  // after a step: the state it started from
+  const Eigen::VectorXd& previousState() const { return zNext_; }
+  double time() const { return t_; }
+  double dt() const { return dt_; }
+  long newtonIterations() const { return newtonIterations_; }
+  const std::string& failure() const { return failure_; }
+
+ private:
+  double dt_;
+  Integrator integrator_;
+  Eigen::VectorXd z_, zNext_;
+  double t_;
+  long newtonIterations_ = 0, cutbacks_ = 0;
+  std::string failure_;
+};
+
+// Time per step of `scheme` at the scene's dt from the initial state, stepping on from the
+// previous state so every iteration is a step of one trajectory.
+void stepBenchmark(benchmark::State& state, const std::shared_ptr<const CompiledScene>& scene, Scheme scheme) {
+  Trajectory trajectory(*scene, scheme, scene->model->initialState(), 0.0, scene->settings.dt);
+  for (auto _ : state)
+    if (!trajectory.step()) {
+      state.SkipWithError(trajectory.failure().c_str());
       break;
     }
-    newtonIterations += outcome.iterations;
-    cutbacks += outcome.cutbacks;
-    z.swap(zNext);
-    t += dt;
-  }
-  state.counters["newton_per_step"] = benchmark::Counter(newtonIterations, benchmark::Counter::kAvgIterations);
-  state.counters["cutbacks_per_step"] = benchmark::Counter(cutbacks, benchmark::Counter::kAvgIterations);
-  state.counters["dofs"] = model.layout().total();
-  state.counters["t_reached"] = t;
+  trajectory.report(state);
 }
 
 // A scheme as the command line names it: the EEM cases of the thermal scenes fix the thermal
@@ -134,6 +206,111 @@ void registerCases(const std::string& sceneName, const SceneSource& source,
   }
 }
 
+// Wall-clock seconds f() takes.
+template <class F>
+double secondsOf(const F& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A solid scene in its loaded phase, prepared on the case's first run (outside timing) and
+// kept for its later runs and repetitions: the state at `loadedTime`, reached from rest by
+// EEM steps of `loadingDt` (larger than the scene's dt, so that the finest mesh gets there in
+// a few steps), the trajectory whose integrator took them (its sparse LU analysed, so no
+// timed step pays for that) and a second solver of the same pattern for timing the solve alone.
+struct LoadedSolid {
+  std::shared_ptr<const CompiledScene> scene;
+  double loadedTime, loadingDt;
+  bool loaded = false;
+  std::optional<Trajectory> trajectory;
+  Eigen::VectorXd state;
+  std::unique_ptr<CondensedSolver> solver;
+
+  // "" or what failed
+  std::string load() {
+    const Model& model = *scene->model;
+    trajectory.emplace(*scene, Scheme::Eem, model.initialState(), 0.0, loadingDt);
+    if (!trajectory->stepTo(loadedTime)) return trajectory->failure();
+    state = trajectory->state();
+    const Assembler& system = trajectory->integrator().evaluate(state, state, loadedTime, scene->settings.dt);
+    solver = std::make_unique<CondensedSolver>(model.layout(), system.tangent());
+    if (!solver->factorize(system.tangent(), true)) return "singular tangent at the loaded state";
+    loaded = true;
+    return "";
+  }
+};
+
+// Time per EEM step of a solid at the scene's dt from its loaded state (every run starts
+// there), and the parts of a Newton iteration, timed after each step (timing paused) on the
+// step just taken: assembly (Integrator::evaluate: every component's residual and tangent
+// scattered into the fixed pattern) at the end state, as in a Newton iteration, and at the
+// start state, as in the step's first evaluation (zNew = zOld, where the discrete stress is
+// the cheaper midpoint stress), and the linear solve (CondensedSolver::factorize + solve with
+// the pattern analysed, as in every Newton iteration after a run's first). Counters:
+// assembly_ms per iteration's evaluation, assembly_start_ms for the first, solve_ms per
+// factorise + solve, condensed unknowns, and the shares of the step they make: a step
+// evaluates once at its start and once per Newton iteration (when the line search takes full
+// steps and there is no cut-back, as in these runs: cutbacks_per_step = 0) and factorises
+// and solves once per iteration.
+void loadedSolidBenchmark(benchmark::State& state, const std::shared_ptr<LoadedSolid>& solid) {
+  if (!solid->loaded) {
+    const std::string failure = solid->load();
+    if (!failure.empty()) {
+      state.SkipWithError(("loading failed: " + failure).c_str());
+      return;
+    }
+  }
+  Trajectory& trajectory = *solid->trajectory;
+  trajectory.restart(solid->state, solid->loadedTime, solid->scene->settings.dt);
+  Integrator& integrator = trajectory.integrator();
+  CondensedSolver& solver = *solid->solver;
+  const double dt = trajectory.dt();
+  Eigen::VectorXd increment(solid->state.size());
+
+  double stepSeconds = 0.0, startSeconds = 0.0, assemblySeconds = 0.0, solveSeconds = 0.0;
+  for (auto _ : state) {
+    bool stepped = false;
+    stepSeconds += secondsOf([&] { stepped = trajectory.step(); });
+    if (!stepped) {
+      state.SkipWithError(trajectory.failure().c_str());
+      break;
+    }
+    state.PauseTiming();
+    const double t = trajectory.time() - dt;
+    startSeconds += secondsOf([&] { integrator.evaluate(trajectory.previousState(), trajectory.previousState(), t, dt); });
+    const Assembler* system = nullptr;
+    assemblySeconds +=
+        secondsOf([&] { system = &integrator.evaluate(trajectory.previousState(), trajectory.state(), t, dt); });
+    solveSeconds += secondsOf([&] {
+      solver.factorize(system->tangent(), false);
+      solver.solve(system->residual(), increment);
+    });
+    state.ResumeTiming();
+  }
+  trajectory.report(state);
+  const double newtonPerStep = static_cast<double>(trajectory.newtonIterations()) / state.iterations();
+  state.counters["condensed"] = solver.condensedSize();
+  state.counters["assembly_ms"] = benchmark::Counter(1e3 * assemblySeconds, benchmark::Counter::kAvgIterations);
+  state.counters["assembly_start_ms"] = benchmark::Counter(1e3 * startSeconds, benchmark::Counter::kAvgIterations);
+  state.counters["solve_ms"] = benchmark::Counter(1e3 * solveSeconds, benchmark::Counter::kAvgIterations);
+  state.counters["assembly_share"] = (startSeconds + newtonPerStep * assemblySeconds) / stepSeconds;
+  state.counters["solve_share"] = newtonPerStep * solveSeconds / stepSeconds;
+}
+
+// Register the EEM step (dt 0.1) of the L-block at mesh level `level` in its loaded phase:
+// from a state at t = 1 (a fifth into the load, reached by two steps of 0.5), `steps` timed
+// steps per run.
+void registerLBlock(const std::string& name, int level, bool viscous, int steps) {
+  auto solid = std::make_shared<LoadedSolid>();
+  solid->scene = std::make_shared<const CompiledScene>(loadSceneText(lblockXml(level, viscous, 0.1), name));
+  solid->loadedTime = 1.0;
+  solid->loadingDt = 0.5;
+  benchmark::RegisterBenchmark((name + "/level" + std::to_string(level) + "/eem").c_str(), loadedSolidBenchmark, solid)
+      ->Iterations(steps)
+      ->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,6 +330,13 @@ int main(int argc, char** argv) {
   registerCases("rigid_chain_50_penalty", sceneText(rigidChainXml(50, "penalty", 1e8, 1e-3), "rigid_chain"),
                 {kEem});
   registerCases("slider_crank_spatial", sceneFile("slider_crank_spatial.xml"), {kEem, kMidpoint});
+  // finite-element solids: the tumbling L-block by mesh level (90 to 14 400 nodes)
+  registerLBlock("lblock_elastic", 1, false, 20);
+  registerLBlock("lblock_elastic", 2, false, 20);
+  registerLBlock("lblock_elastic", 4, false, 10);
+  registerLBlock("lblock_elastic", 7, false, 2);  // one to two minutes: seconds per Newton iteration
+  registerLBlock("lblock_viscoelastic", 1, true, 20);
+  registerLBlock("lblock_viscoelastic", 2, true, 10);
 
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

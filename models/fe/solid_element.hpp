@@ -34,9 +34,12 @@ class SolidElement final : public Component {
  public:
   explicit SolidElement(SolidElementSpec spec);
 
-  // momentum and viscous rows depend on positions and viscous strains, not on velocities
+  // momentum rows depend on positions and every viscous strain, the viscous rows of a point on
+  // positions and that point's own strains; nothing depends on velocities
   bool couples(int row, int column) const override {
-    return row >= 3 * nodes_ && (column < 3 * nodes_ || column >= 6 * nodes_);
+    const int strains = 6 * nodes_;
+    if (row < 3 * nodes_ || (column >= 3 * nodes_ && column < strains)) return false;
+    return row < strains || column < strains || (row - strains) / 6 == (column - strains) / 6;
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
