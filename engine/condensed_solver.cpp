@@ -15,14 +15,19 @@ int entryIndex(const SparseMatrix& matrix, int row, int column) {
 }
 }  // namespace
 
-CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) {
+CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : pattern_(&pattern) {
   // positions come first in the layout, velocities right after, dof for dof
   const bool paired = layout.has(Block::Position) && layout.size(Block::Position) == layout.size(Block::Velocity) &&
                       layout.offset(Block::Position) == 0;
   velocities_ = paired ? layout.size(Block::Velocity) : 0;
   if (velocities_ > 0 && !buildCondensation(pattern)) velocities_ = 0;
   reducedRhs_.resize(pattern.rows() - velocities_);
-  lu_ = makeSparseLu(static_cast<int>(pattern.rows()) - velocities_);
+  // internal variables, numbered as in the velocity-condensed system
+  const SparseMatrix& stage = velocities_ > 0 ? reduced_ : pattern;
+  internal_.build(stage, layout.offset(Block::Internal) - velocities_, layout.size(Block::Internal));
+  internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
+  internalSolution_.resize(stage.rows());
+  lu_ = makeSparseLu(static_cast<int>(factorised().rows()));
 }
 
 bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
@@ -84,20 +89,35 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
 
 bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
   tangent_ = &tangent;
-  if (velocities_ == 0) return lu_->factorize(tangent, repivot);
+  if (velocities_ > 0) condenseVelocities(tangent);
+  if (!internal_.active()) return lu_->factorize(velocityCondensed(), repivot);
+  return internal_.reduce(velocityCondensed()) && lu_->factorize(internal_.reduced(), repivot);
+}
+
+void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
   const double* k = tangent.valuePtr();
   double* reduced = reduced_.valuePtr();
   std::fill_n(reduced, reduced_.nonZeros(), 0.0);
   for (const auto& [entry, reducedEntry] : directEntries_) reduced[reducedEntry] += k[entry];
   for (const ProductTerm& term : productTerms_)
     reduced[term.reducedEntry] -= k[term.velocityEntry] * k[term.kinematicEntry] / k[term.pivotEntry];
-  return lu_->factorize(reduced_, repivot);
+}
+
+void CondensedSolver::solveVelocityCondensed(Eigen::VectorXd& rhs) {
+  if (!internal_.active()) {
+    lu_->solve(rhs);
+    return;
+  }
+  internal_.reduceRhs(rhs, internalRhs_);
+  lu_->solve(internalRhs_);
+  internal_.recover(rhs, internalRhs_, internalSolution_);
+  rhs.swap(internalSolution_);
 }
 
 void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment) {
   if (velocities_ == 0) {
     increment = -residual;
-    lu_->solve(increment);
+    solveVelocityCondensed(increment);
     return;
   }
   const SparseMatrix& K = *tangent_;
@@ -111,7 +131,7 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
     for (SparseMatrix::InnerIterator it(K, nv + i); it; ++it)
       if (it.row() >= nv) reducedRhs_[reducedRow(static_cast<int>(it.row()))] += it.value() * factor;
   }
-  lu_->solve(reducedRhs_);
+  solveVelocityCondensed(reducedRhs_);
 
   // kept unknowns, then the velocities from their kinematic rows
   increment.head(nv) = reducedRhs_.head(nv);

@@ -6,7 +6,11 @@
 // and substituting it leaves a system in positions, thermal, internal and multiplier
 // unknowns only, with the momentum rows in place of the kinematic ones: half the size for
 // mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
-// Scenes whose pattern does not have this structure are solved whole.
+// Scenes whose pattern does not have this structure are solved whole. Internal variables that
+// split into small independent groups (per quadrature point, per Maxwell element) are then
+// eliminated as well (engine/group_elimination), so that what is factorised is the system of
+// positions, thermal unknowns and multipliers.
+#include "group_elimination.hpp"
 #include "layout.hpp"
 #include "sparse_lu.hpp"
 
@@ -28,7 +32,7 @@ class CondensedSolver {
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Unknowns of the system actually factorised.
-  int condensedSize() const { return static_cast<int>(reduced_.rows()); }
+  int condensedSize() const { return static_cast<int>(factorised().rows()); }
 
  private:
   // One term K(j, v_i) K(q_i, c) / d_i of the condensed entry (j, c).
@@ -40,11 +44,20 @@ class CondensedSolver {
     int column, entry;
   };
   bool buildCondensation(const Eigen::SparseMatrix<double>& pattern);
+  void condenseVelocities(const Eigen::SparseMatrix<double>& tangent);
+  // Solve the velocity-condensed system in place, through the internal elimination if any.
+  void solveVelocityCondensed(Eigen::VectorXd& rhs);
   // Index of a kept row / column in the condensed system (velocity row v_i takes q_i's place).
   int reducedRow(int row) const { return row - velocities_; }
   int reducedColumn(int column) const { return column < velocities_ ? column : column - velocities_; }
+  // The matrix after velocity condensation (the tangent itself without it).
+  const Eigen::SparseMatrix<double>& velocityCondensed() const { return velocities_ > 0 ? reduced_ : *tangent_; }
+  const Eigen::SparseMatrix<double>& factorised() const {
+    return internal_.active() ? internal_.reduced() : velocities_ > 0 ? reduced_ : *pattern_;
+  }
 
   int velocities_ = 0;  // 0: solved whole
+  const Eigen::SparseMatrix<double>* pattern_;
   const Eigen::SparseMatrix<double>* tangent_ = nullptr;
   Eigen::SparseMatrix<double> reduced_;
   std::vector<std::pair<int, int>> directEntries_;  // (entry in K, entry in the condensed matrix)
@@ -52,6 +65,8 @@ class CondensedSolver {
   std::vector<int> pivotEntry_;                      // per q_i: position of d_i in K
   std::vector<std::vector<RowEntry>> kinematicRows_;  // per q_i
   Eigen::VectorXd reducedRhs_;
+  GroupElimination internal_;
+  Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
   std::unique_ptr<SparseLu> lu_;
 };
 
