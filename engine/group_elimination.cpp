@@ -66,6 +66,10 @@ bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) 
     for (auto* list : {&rowsOf[g], &columnsOf[g]}) {
       std::sort(list->begin(), list->end());
       list->erase(std::unique(list->begin(), list->end()), list->end());
+      if (list->size() > static_cast<std::size_t>(kMaxCoupling)) {
+        first_ = count_ = 0;
+        return false;
+      }
     }
     for (int row : rowsOf[g])
       for (int column : columnsOf[g]) entries.emplace_back(keptIndex(row), keptIndex(column), 0.0);
@@ -104,26 +108,25 @@ bool GroupElimination::reduce(const SparseMatrix& matrix) {
   double* out = reduced_.valuePtr();
   std::fill_n(out, reduced_.nonZeros(), 0.0);
   for (const auto& [entry, reducedEntry] : directEntries_) out[reducedEntry] += k[entry];
-  // K_cc -= K_cg B^-1 K_gc, one column of K_gc at a time (fixed-size scratch: no allocation)
+  // K_cc -= K_cg (B^-1 K_gc) with dense blocks of fixed capacity (no allocation)
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const Group& group = groups_[g];
     const int s = static_cast<int>(group.members.size());
+    const int rows = static_cast<int>(group.rows.size()), columns = static_cast<int>(group.columns.size());
     Block block(s, s);
     for (int a = 0; a < s; ++a)
       for (int b = 0; b < s; ++b) block(a, b) = valueAt(k, group.blockEntries[a * s + b]);
     factors_[g].compute(block);
     if (!(std::abs(factors_[g].determinant()) > 0.0)) return false;
-    const int rows = static_cast<int>(group.rows.size()), columns = static_cast<int>(group.columns.size());
-    for (int c = 0; c < columns; ++c) {
-      GroupVector coupling(s);
-      for (int m = 0; m < s; ++m) coupling[m] = valueAt(k, group.columnEntries[m * columns + c]);
-      const GroupVector x = factors_[g].solve(coupling);
-      for (int r = 0; r < rows; ++r) {
-        double product = 0.0;
-        for (int m = 0; m < s; ++m) product += valueAt(k, group.rowEntries[r * s + m]) * x[m];
-        out[group.fillEntries[r * columns + c]] -= product;
-      }
-    }
+    ColumnCoupling columnCoupling(s, columns);
+    for (int m = 0; m < s; ++m)
+      for (int c = 0; c < columns; ++c) columnCoupling(m, c) = valueAt(k, group.columnEntries[m * columns + c]);
+    RowCoupling rowCoupling(rows, s);
+    for (int r = 0; r < rows; ++r)
+      for (int m = 0; m < s; ++m) rowCoupling(r, m) = valueAt(k, group.rowEntries[r * s + m]);
+    const ColumnCoupling solved = factors_[g].solve(columnCoupling);
+    for (int c = 0; c < columns; ++c)
+      for (int r = 0; r < rows; ++r) out[group.fillEntries[r * columns + c]] -= rowCoupling.row(r).dot(solved.col(c));
   }
   return true;
 }

@@ -14,8 +14,11 @@ namespace mpx {
 
 class GroupElimination {
  public:
-  // Largest group eliminated; a larger coupled set of internal unknowns is left in place.
+  // Largest group eliminated, and most kept rows or columns one group may couple to (a
+  // hexahedron's 24 momentum rows and positions, a joint force's two bodies); beyond either the
+  // internal unknowns are left in place.
   static constexpr int kMaxGroup = 8;
+  static constexpr int kMaxCoupling = 96;
 
   // Eliminate the unknowns [first, first + count) of matrices with `pattern` (rows = columns).
   // Returns false, and leaves the system alone, unless their block splits into groups of at
@@ -34,6 +37,8 @@ class GroupElimination {
  private:
   using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxGroup, kMaxGroup>;
   using GroupVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxGroup, 1>;
+  using RowCoupling = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxCoupling, kMaxGroup>;
+  using ColumnCoupling = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxGroup, kMaxCoupling>;
   // Entry positions (-1: structurally zero) of one group, row-major within each list.
   struct Group {
     std::vector<int> members;           // unknowns of the whole system
