@@ -3,6 +3,8 @@
 #include "engine/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
 
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -10,6 +12,14 @@ namespace mpx::test {
 
 // Path of a file in scenes/.
 inline std::string scenePath(const std::string& file) { return std::string(METRIPLEX_SCENES_DIR) + "/" + file; }
+
+// The whole text of a file ("" if it cannot be read).
+inline std::string readFile(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
 
 // Test-name fragment of a one-step scheme.
 inline std::string schemeName(Scheme scheme) {

@@ -1,6 +1,8 @@
 // End-to-end tests of the metriplex command line: exit codes, error messages that point at the
 // offending file, line, element and attribute, no output directory on invalid input, and
 // DIR/history.csv on success and on a solver failure.
+#include "support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -23,12 +25,7 @@ constexpr int kExitSuccess = 0;
 constexpr int kExitInvalidInput = 2;
 constexpr int kExitSolverFailure = 3;
 
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
+using mpx::test::readFile;
 
 std::vector<std::string> splitLines(const std::string& text) {
   std::vector<std::string> lines;

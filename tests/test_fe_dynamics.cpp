@@ -426,6 +426,24 @@ TEST(FlexiblePendulum, EnergyBalanceAndJointsHoldToRoundOff) {
   EXPECT_GT(h.dissipated.back(), 0.0);
 }
 
+// The same pendulum with every joint enforced by a penalty (kappa = 1e8): the penalty energy is
+// part of E, so the balance stays exact while the joints hold to about force / kappa.
+TEST(FlexiblePendulum, PenaltyJointsKeepTheBalanceAndHoldToForceOverStiffness) {
+  std::string text = readFile(scenePath("flexible_pendulum.xml"));
+  text.replace(text.find("<anchor"), 0, R"(<constraints enforcement="penalty" stiffness="1e8"/>
+  )");
+  const SceneRun r = runScene(loadSceneText(text, scenePath("flexible_pendulum_penalty.xml")), Scheme::Eem, 0.005, 0.5);
+  const History& h = r.history;
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const double balanceError = driftAfter(energyBalance(h), 0, 8.0 * 9.81 * 2.0);
+  const double violation = maxViolation(*r.scene.model, h);
+  std::printf("flexible pendulum, penalty 1e8: |E + D - E0| %.2e m g L, max constraint violation %.2e\n", balanceError,
+              violation);
+  EXPECT_EQ(r.scene.model->layout().size(Block::Multiplier), 0);
+  EXPECT_LE(balanceError, 1e-9);
+  EXPECT_LE(violation, 1e-5);
+}
+
 // ---------------------------------------------------------------------------------------------
 // 8. The velocity-condensed Newton solve against a plain sparse LU of the whole tangent, at a
 // generic step of FE scenes (clamps, joints with multipliers) and a rigid multibody scene, for
