@@ -183,6 +183,20 @@ const std::vector<BadScene> kBadScenes = {
     {"ReservoirEntropyOverflowingTemperature",
      sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" entropy=\"1000\"/>"), "", 5,
      {"<reservoir name=\"env\">", "entropy"}},
+    {"SolidWithNonPhysicalPoisson",
+     sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.5\" density=\"1\"/>"), "", 5,
+     {"<solid name=\"b\">", "Poisson"}},
+    {"SolidMeshFileMissing",
+     sceneWith("  <solid name=\"b\" mesh=\"missing.msh\" young=\"10\" poisson=\"0.3\" density=\"1\"/>"), "", 5,
+     {"<solid name=\"b\">", "missing.msh", "cannot open"}},
+    {"ClampOnUnknownSurface",
+     sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
+               "  <clamp solid=\"b\" surface=\"top\"/>"),
+     "", 6, {"<clamp>", "no surface or node set 'top'", "x0"}},
+    {"TractionWithoutLoad",
+     sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
+               "  <traction name=\"t\" solid=\"b\" surface=\"x1\"/>"),
+     "", 6, {"<traction name=\"t\">", "'traction'", "'total_force'"}},
 };
 
 class BadSceneTest : public CliTest, public ::testing::WithParamInterface<BadScene> {};

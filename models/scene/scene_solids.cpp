@@ -96,6 +96,8 @@ void SceneCompiler::loadSolidMeshes() {
       solidMeshes_[name] = std::make_shared<const Mesh>(buildMesh(source, file_));
     } catch (const std::invalid_argument& error) {
       in.fail(error.what());
+    } catch (const InputError& error) {
+      in.fail(std::string("mesh ") + error.what());  // the mesh file's own line, and this element's
     }
     if (solidMeshes_[name]->cells.empty()) in.fail("the mesh has no cells");
   }
