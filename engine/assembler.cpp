@@ -1,5 +1,7 @@
 #include "assembler.hpp"
 
+#include "sparse_entry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -35,10 +37,7 @@ Assembler::Assembler(const Model& model) {
     for (std::size_t j = 0; j < dofs.size(); ++j)
       for (std::size_t i = 0; i < dofs.size(); ++i) {
         if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
-        const int* begin = inner + outer[dofs[j]];
-        const int* end = inner + outer[dofs[j] + 1];
-        map.emplace_back(static_cast<int>(i + j * dofs.size()),
-                         static_cast<int>(std::lower_bound(begin, end, dofs[i]) - inner));
+        map.emplace_back(static_cast<int>(i + j * dofs.size()), findEntry(tangent_, dofs[i], dofs[j]));
       }
     scatterMap_.push_back(std::move(map));
   }
@@ -49,8 +48,7 @@ Assembler::Assembler(const Model& model) {
   for (std::size_t k = 0; k < prescribed.size(); ++k) prescribedIndex[prescribed[k].dof] = static_cast<int>(k);
   for (int e = 0; e < outer[n]; ++e)
     if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
-  for (const PrescribedVelocity& p : prescribed)
-    prescribedDiagonal_.push_back(static_cast<int>(std::lower_bound(inner + outer[p.dof], inner + outer[p.dof + 1], p.dof) - inner));
+  for (const PrescribedVelocity& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
   localResidual_.assign(kMaxLocalDofs, 0.0);
   localTangent_.assign(kMaxLocalDofs * kMaxLocalDofs, 0.0);
 }

@@ -1,18 +1,13 @@
 #include "condensed_solver.hpp"
 
+#include "sparse_entry.hpp"
+
 #include <algorithm>
 
 namespace mpx {
 
 namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
-
-// Position of (row, column) in the compressed values of `matrix`; the entry must exist.
-int entryIndex(const SparseMatrix& matrix, int row, int column) {
-  const int* begin = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column];
-  const int* end = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column + 1];
-  return static_cast<int>(std::lower_bound(begin, end, row) - matrix.innerIndexPtr());
-}
 }  // namespace
 
 CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : pattern_(&pattern) {
@@ -76,13 +71,13 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
       if (isPosition(row)) continue;
       const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
       if (!isVelocity(column)) {
-        directEntries_.emplace_back(entry, entryIndex(reduced_, reducedRow(row), reducedColumn(column)));
+        directEntries_.emplace_back(entry, findEntry(reduced_, reducedRow(row), reducedColumn(column)));
         continue;
       }
       const int i = column - nv;
       for (const RowEntry& kinematic : kinematicRows_[i])
         productTerms_.push_back({entry, kinematic.entry, pivotEntry_[i],
-                                 entryIndex(reduced_, reducedRow(row), reducedColumn(kinematic.column))});
+                                 findEntry(reduced_, reducedRow(row), reducedColumn(kinematic.column))});
     }
   return true;
 }

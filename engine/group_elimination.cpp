@@ -1,5 +1,7 @@
 #include "group_elimination.hpp"
 
+#include "sparse_entry.hpp"
+
 #include <algorithm>
 #include <numeric>
 
@@ -7,14 +9,6 @@ namespace mpx {
 
 namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
-
-// Position of (row, column) in the values of `matrix`, or -1 if not in its pattern.
-int findEntry(const SparseMatrix& matrix, int row, int column) {
-  const int* begin = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column];
-  const int* end = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column + 1];
-  const int* it = std::lower_bound(begin, end, row);
-  return it != end && *it == row ? static_cast<int>(it - matrix.innerIndexPtr()) : -1;
-}
 
 // Union-find root with path halving.
 int rootOf(std::vector<int>& parent, int i) {
