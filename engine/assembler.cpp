@@ -42,13 +42,13 @@ Assembler::Assembler(const Model& model) {
     scatterMap_.push_back(std::move(map));
   }
   // rows of the prescribed velocities, to be overwritten
-  const auto& prescribed = model.prescribedVelocities();
+  const auto& prescribed = model.prescribedMotions();
   prescribedRowEntries_.assign(prescribed.size(), {});
   std::vector<int> prescribedIndex(n, -1);
   for (std::size_t k = 0; k < prescribed.size(); ++k) prescribedIndex[prescribed[k].dof] = static_cast<int>(k);
   for (int e = 0; e < outer[n]; ++e)
     if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
-  for (const PrescribedVelocity& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
+  for (const PrescribedMotion& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
   localResidual_.assign(kMaxLocalDofs, 0.0);
   localTangent_.assign(kMaxLocalDofs * kMaxLocalDofs, 0.0);
 }
@@ -74,19 +74,23 @@ void Assembler::replaceRow(std::size_t k, int dof, double value, double diagonal
   residual_[dof] = value;
 }
 
-void Assembler::imposeStepVelocities(const Model& model, const double* zOld, const double* zNew, double t, double dt) {
-  const auto& prescribed = model.prescribedVelocities();
+void Assembler::imposeStepMotions(const Model& model, const double* zOld, const double* zNew, double t, double dt) {
+  const auto& prescribed = model.prescribedMotions();
   for (std::size_t k = 0; k < prescribed.size(); ++k) {
-    const PrescribedVelocity& p = prescribed[k];
+    const PrescribedMotion& p = prescribed[k];
     const double change = p.amplitude * (p.profile(t + dt) - p.profile(t));
-    replaceRow(k, p.dof, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, 0.5 * (zOld[p.dof] + zNew[p.dof]));
+    const double meanVelocity = 0.5 * (zOld[p.dof] + zNew[p.dof]);
+    if (p.displacement)
+      replaceRow(k, p.dof, meanVelocity - change / dt, 0.5, meanVelocity);
+    else
+      replaceRow(k, p.dof, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, meanVelocity);
   }
 }
 
-void Assembler::imposeRateVelocities(const Model& model, const double* z, const double* zdot, double t, double beta) {
-  const auto& prescribed = model.prescribedVelocities();
+void Assembler::imposeRateMotions(const Model& model, const double* z, const double* zdot, double t, double beta) {
+  const auto& prescribed = model.prescribedMotions();
   for (std::size_t k = 0; k < prescribed.size(); ++k) {
-    const PrescribedVelocity& p = prescribed[k];
+    const PrescribedMotion& p = prescribed[k];
     replaceRow(k, p.dof, zdot[p.dof] - p.amplitude * p.profile.slope(t), beta, z[p.dof]);
   }
 }

@@ -21,11 +21,12 @@ class Assembler {
   void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
     add(model, ws, 1.0, [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
   }
-  // Replace the rows of prescribed velocities by v' = V(t + dt) for the step zOld -> zNew
-  // (tangent 1/dt), with the reaction's work at the mean velocity.
-  void imposeStepVelocities(const Model& model, const double* zOld, const double* zNew, double t, double dt);
-  // The same in rate form: vdot = dV/dt(t), tangent beta.
-  void imposeRateVelocities(const Model& model, const double* z, const double* zdot, double t, double beta);
+  // Replace the rows of prescribed motions for the step zOld -> zNew: v' = V(t + dt) (tangent
+  // 1/dt) or (v + v')/2 = (u(t + dt) - u(t))/dt (tangent 1/2), with the reaction's work at the
+  // mean velocity.
+  void imposeStepMotions(const Model& model, const double* zOld, const double* zNew, double t, double dt);
+  // The same in rate form, for prescribed velocities: vdot = dV/dt(t), tangent beta.
+  void imposeRateMotions(const Model& model, const double* z, const double* zdot, double t, double beta);
   // Add every component's rate residual and tangent times `weight` (trapezoidal rule: two
   // evaluations of weight 1/2).
   void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
@@ -63,7 +64,7 @@ class Assembler {
   double relativeResidualNorm() const;
 
  private:
-  // Prescribed velocity k: its row becomes `value` with `diagonal` as the only tangent entry;
+  // Prescribed motion k: its row becomes `value` with `diagonal` as the only tangent entry;
   // the reaction (the row's residual before) does work at `velocity`.
   void replaceRow(std::size_t k, int dof, double value, double diagonal, double velocity);
   void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);
@@ -74,7 +75,7 @@ class Assembler {
   Flows flows_;
   // per component: (local column-major entry, position in tangent_ values) of its coupled pairs
   std::vector<std::vector<std::pair<int, int>>> scatterMap_;
-  std::vector<std::vector<int>> prescribedRowEntries_;  // per prescribed velocity: its row in tangent_ values
+  std::vector<std::vector<int>> prescribedRowEntries_;  // per prescribed motion: its row in tangent_ values
   std::vector<int> prescribedDiagonal_;
   std::vector<double> localResidual_;
   std::vector<double> localTangent_;

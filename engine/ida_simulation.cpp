@@ -132,7 +132,7 @@ void IdaProblem::errorHandler(int code, const char*, const char* function, char*
 void IdaProblem::evaluate(double t, N_Vector y, N_Vector yp, double cj) {
   assembler_.clear();
   assembler_.addRate(model_, workspace_, {N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, 1.0, cj}, 1.0);
-  assembler_.imposeRateVelocities(model_, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, cj);
+  assembler_.imposeRateMotions(model_, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, cj);
 }
 
 int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* user) {

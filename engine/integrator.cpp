@@ -31,7 +31,7 @@ Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::Vector
   } else {
     addRateForm(zOld, zNew, t, dt);
   }
-  assembler_.imposeStepVelocities(model_, zOld.data(), zNew.data(), t, dt);
+  assembler_.imposeStepMotions(model_, zOld.data(), zNew.data(), t, dt);
   return assembler_;
 }
 

@@ -1,5 +1,7 @@
 #include "method.hpp"
 
+#include "input_error.hpp"
+
 namespace mpx {
 
 std::optional<Method> methodByName(const std::string& name) {
@@ -10,6 +12,14 @@ std::optional<Method> methodByName(const std::string& name) {
   if (name == "trapezoidal") return Method{name, false, Scheme::Trapezoidal, std::nullopt};
   if (name == "ida") return Method{name, true, Scheme::Eem, std::nullopt};
   return std::nullopt;
+}
+
+void checkMethodSupports(const Method& method, const Model& model, const std::string& scene) {
+  if (!method.ida) return;
+  for (const PrescribedMotion& motion : model.prescribedMotions())
+    if (motion.displacement)
+      throw InputError(scene + ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
+                       "<prescribed_velocity>, or use a one-step integrator");
 }
 
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& p, const StepSink& sink,

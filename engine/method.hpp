@@ -30,6 +30,12 @@ struct MethodParameters {
   int maxOrder = 5;                 // IDA
 };
 
+// Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a
+// velocity (a displacement is imposed step by step through the mean velocity, which a rate form
+// cannot express).
+// `scene` names the scene file in the message.
+void checkMethodSupports(const Method& method, const Model& model, const std::string& scene);
+
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters,
                      const StepSink& sink, const ProgressSink& progress = nullptr);
 

@@ -6,14 +6,14 @@ namespace mpx {
 
 Model::Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
              std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
-             std::vector<PrescribedVelocity> prescribedVelocities)
+             std::vector<PrescribedMotion> prescribedMotions)
     : layout_(layout),
       thermalVariable_(thermalVariable),
       components_(std::move(components)),
       thermalNodeNames_(std::move(thermalNodeNames)),
       initialState_(std::move(initialState)),
       dofScale_(std::move(dofScale)),
-      prescribedVelocities_(std::move(prescribedVelocities)) {
+      prescribedMotions_(std::move(prescribedMotions)) {
   // couplings read what the others publish: evaluate them last
   std::stable_partition(components_.begin(), components_.end(),
                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); });

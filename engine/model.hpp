@@ -17,19 +17,23 @@ namespace mpx {
 // Which thermal variable the Thermal block holds.
 enum class ThermalVariable { Temperature, Entropy };
 
-// A velocity dof held at v(t) = amplitude * profile(t) (a clamped or driven node): its
-// momentum row is replaced by that condition, and the reaction force does boundary work.
-struct PrescribedVelocity {
+// A velocity dof whose motion is prescribed (a clamped or driven node): its momentum row is
+// replaced by the condition, and the reaction force does boundary work. Either the velocity
+// v(t) = amplitude * profile(t), or the displacement u(t) = amplitude * profile(t), imposed in
+// a step through the mean velocity (v + v')/2 = (u(t + dt) - u(t))/dt, which the kinematic row
+// turns into x' - x = u(t + dt) - u(t) exactly.
+struct PrescribedMotion {
   int dof;
   double amplitude;
   TimeFunction profile;
+  bool displacement = false;
 };
 
 class Model {
  public:
   Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
         std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
-        std::vector<PrescribedVelocity> prescribedVelocities = {});
+        std::vector<PrescribedMotion> prescribedMotions = {});
 
   const Layout& layout() const { return layout_; }
   ThermalVariable thermalVariable() const { return thermalVariable_; }
@@ -39,7 +43,7 @@ class Model {
   const Eigen::VectorXd& initialState() const { return initialState_; }
   // Characteristic magnitude of each dof, used to weigh Newton increments.
   const Eigen::VectorXd& dofScale() const { return dofScale_; }
-  const std::vector<PrescribedVelocity>& prescribedVelocities() const { return prescribedVelocities_; }
+  const std::vector<PrescribedMotion>& prescribedMotions() const { return prescribedMotions_; }
 
   // Energy, entropy, momenta and node temperatures of state z; `out` is reused (no allocation
   // once sized).
@@ -53,7 +57,7 @@ class Model {
   std::vector<std::string> thermalNodeNames_;
   Eigen::VectorXd initialState_;
   Eigen::VectorXd dofScale_;
-  std::vector<PrescribedVelocity> prescribedVelocities_;
+  std::vector<PrescribedMotion> prescribedMotions_;
 };
 
 }  // namespace mpx

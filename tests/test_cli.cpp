@@ -250,6 +250,19 @@ const std::vector<BadOptions> kBadOptions = {
     {"BenchZeroRepeats", "bench", "--repeats 0", {"--repeats"}},
 };
 
+// IDA's rate form cannot impose a displacement step by step: refused before anything is written,
+// naming the scene and the element (run and bench, whose reference is an IDA run).
+TEST_F(CliTest, IdaRefusesAPrescribedDisplacement) {
+  const fs::path scene = writeScene(readFile(mpx::test::scenePath("stretched_bar.xml")));
+  for (const std::string command : {"run --integrator ida", "bench --integrators eem"}) {
+    const Invocation r = metriplex(command + " " + quoted(scene) + " --out " + quoted(outDir()));
+    EXPECT_EQ(r.exitCode, kExitInvalidInput) << command << ": " << r.err;
+    EXPECT_NE(r.err.find(scene.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("<prescribed_displacement>"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(outDir()));
+  }
+}
+
 class BadOptionsTest : public CliTest, public ::testing::WithParamInterface<BadOptions> {};
 
 TEST_P(BadOptionsTest, ExitsTwoWithCauseAndWritesNothing) {

@@ -180,6 +180,7 @@ int benchCommand(const BenchRequest& request) {
   for (const Method& method : methods)
     scenes.emplace(method.name, loadScene(request.scene, method.thermalVariable));
   const CompiledScene own = loadScene(request.scene);
+  checkMethodSupports(*methodByName("ida"), *own.model, request.scene);  // the reference is an IDA run
   const SceneSettings& settings = own.settings;
   const double tEnd = request.tEnd.value_or(settings.tEnd);
   std::vector<double> steps = request.steps;

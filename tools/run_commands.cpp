@@ -67,6 +67,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   if (!request.integrator.empty()) method = methodOrThrow(request.integrator);
   CompiledScene scene = loadScene(request.scene, method ? method->thermalVariable : std::nullopt);
   if (!method) method = methodOrThrow(scene.settings.integrator);
+  checkMethodSupports(*method, *scene.model, request.scene);
 
   MethodParameters parameters;
   parameters.dt = request.dt.value_or(scene.settings.dt);

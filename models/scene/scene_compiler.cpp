@@ -66,7 +66,7 @@ CompiledScene SceneCompiler::compile() {
     scale_[v] = std::max(std::abs(state_[v]), length / settings_.tEnd);
   }
   auto model = std::make_unique<Model>(layout_, variable_, std::move(components_), thermalNodeNames_, state_, scale_,
-                                      std::move(prescribedVelocities_));
+                                      std::move(prescribedMotions_));
   return {settings_, std::move(model), std::move(bodyFrames_), std::move(jointCoordinates_), std::move(solids_)};
 }
 
@@ -152,8 +152,9 @@ void SceneCompiler::addElement(const XMLElement& element) {
   else if (tag == "solid") addSolid(in);
   else if (tag == "traction") addTraction(in);
   else if (tag == "body_force") addBodyForce(in);
-  else if (tag == "clamp") addPrescribedVelocity(in, true);
-  else if (tag == "prescribed_velocity") addPrescribedVelocity(in, false);
+  else if (tag == "clamp") addPrescribedMotion(in, MotionKind::Clamp);
+  else if (tag == "prescribed_velocity") addPrescribedMotion(in, MotionKind::Velocity);
+  else if (tag == "prescribed_displacement") addPrescribedMotion(in, MotionKind::Displacement);
   else if (tag == "solid_joint") addSolidJoint(in);
   else in.fail("unknown element (see docs/scene-format.md for the elements a scene may hold)");
   in.finish();

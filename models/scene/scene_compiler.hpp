@@ -62,7 +62,8 @@ class SceneCompiler {
   void addSolid(ElementReader& in);
   void addTraction(ElementReader& in);
   void addBodyForce(ElementReader& in);
-  void addPrescribedVelocity(ElementReader& in, bool clamp);
+  enum class MotionKind { Clamp, Velocity, Displacement };
+  void addPrescribedMotion(ElementReader& in, MotionKind kind);
   void addSolidJoint(ElementReader& in);
   // The solid named by attribute 'solid' and the sorted nodes of its set named by 'surface'.
   const SolidOutput& solidOf(ElementReader& in);
@@ -114,7 +115,7 @@ class SceneCompiler {
   std::vector<JointCoordinate> jointCoordinates_;
   std::map<std::string, std::shared_ptr<const Mesh>> solidMeshes_;  // by solid name, loaded before the layout
   std::vector<SolidOutput> solids_;
-  std::vector<PrescribedVelocity> prescribedVelocities_;
+  std::vector<PrescribedMotion> prescribedMotions_;
   ConstraintSettings constraintDefaults_;
   int positionCount_ = 0, thermalCount_ = 0, internalCount_ = 0, multiplierCount_ = 0;
   double positionScale_ = 0.0;

@@ -267,28 +267,31 @@ void SceneCompiler::addBodyForce(ElementReader& in) {
   addNodalForces(name, solid, forces, readProfile(in));
 }
 
-void SceneCompiler::addPrescribedVelocity(ElementReader& in, bool clamp) {
+void SceneCompiler::addPrescribedMotion(ElementReader& in, MotionKind kind) {
   const SolidOutput& solid = solidOf(in);
   const std::vector<int> nodes = solidNodes(in, solid);
   const std::string directions = in.text("directions", "xyz");
   if (directions.empty() || directions.find_first_not_of("xyz") != std::string::npos)
     in.fail("directions must be letters from 'xyz', got '" + directions + "'");
-  const Vec3 velocity = clamp ? Vec3::Zero() : in.vector("velocity", Vec3::Zero());
+  const bool clamp = kind == MotionKind::Clamp, displacement = kind == MotionKind::Displacement;
+  const Vec3 amplitude = clamp ? Vec3::Zero() : in.vector(displacement ? "displacement" : "velocity", Vec3::Zero());
   const TimeFunction profile = clamp ? TimeFunction::constant(0.0) : readProfile(in);
+  // the initial velocity that the motion starts with
+  const Vec3 startVelocity = amplitude * (displacement ? profile.slope(0.0) : profile(0.0));
   for (int node : nodes)
     for (char direction : directions) {
       const int k = direction - 'x';
       const int dof = solid.firstPositionDof + 3 * node + k + solid.velocityShift;
       // supports meeting at an edge may prescribe a dof twice: the same clamp is fine
-      const auto same = std::find_if(prescribedVelocities_.begin(), prescribedVelocities_.end(),
-                                     [&](const PrescribedVelocity& p) { return p.dof == dof; });
-      if (same != prescribedVelocities_.end()) {
+      const auto same = std::find_if(prescribedMotions_.begin(), prescribedMotions_.end(),
+                                     [&](const PrescribedMotion& p) { return p.dof == dof; });
+      if (same != prescribedMotions_.end()) {
         if (clamp && same->amplitude == 0.0) continue;
-        in.fail("node " + std::to_string(node) + " of '" + solid.name + "' already has a prescribed velocity in " +
+        in.fail("node " + std::to_string(node) + " of '" + solid.name + "' already has a prescribed motion in " +
                 direction);
       }
-      prescribedVelocities_.push_back({dof, velocity[k], profile});
-      state_[dof] = velocity[k] * profile(0.0);
+      prescribedMotions_.push_back({dof, amplitude[k], profile, displacement});
+      state_[dof] = startVelocity[k];
     }
 }
 
