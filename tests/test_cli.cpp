@@ -300,6 +300,29 @@ TEST_F(CliTest, RunWritesOneHistoryRowPerStepPlusOne) {
   EXPECT_FALSE(fs::exists(outDir() / "history.csv.part"));
 }
 
+// A solid writes a ParaView series, one frame per --output-interval, each frame with all of its
+// nodes and cells, and a picture of the last frame; no .part file stays behind.
+TEST_F(CliTest, SolidRunWritesAParaViewSeriesAndAPicture) {
+  const std::string scene = sceneWith(
+      "  <solid name=\"block\" mesh=\"box\" size=\"2 1 1\" cells=\"2 1 1\" young=\"1000\" poisson=\"0.3\" "
+      "density=\"10\" angular_velocity=\"0 0 1\"/>");
+  const Invocation r = metriplex("run " + quoted(writeScene(scene)) + " --output-interval 0.5 --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::string pvd = readFile(outDir() / "block.pvd");
+  for (int frame = 0; frame < 3; ++frame) {  // t = 0, 0.5, 1
+    const std::string file = "block/frame_0000" + std::to_string(frame) + ".vtu";
+    EXPECT_NE(pvd.find(file), std::string::npos) << pvd;
+    const std::string vtu = readFile(outDir() / file);
+    EXPECT_NE(vtu.find("NumberOfPoints=\"12\" NumberOfCells=\"2\""), std::string::npos) << file;
+    for (const char* field : {"displacement", "velocity", "cauchy_stress", "von_mises", "viscous_strain"})
+      EXPECT_NE(vtu.find(field), std::string::npos) << file << " lacks " << field;
+  }
+  EXPECT_FALSE(fs::exists(outDir() / "block" / "frame_00003.vtu"));
+  EXPECT_TRUE(fs::exists(outDir() / "block.png")) << r.err;
+  for (const auto& entry : fs::recursive_directory_iterator(outDir()))
+    EXPECT_NE(entry.path().extension(), ".part") << entry.path();
+}
+
 // --dt and --t-end replace the scene's step and end time
 TEST_F(CliTest, StepAndEndTimeOptionsOverrideTheScene) {
   const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) + " --integrator midpoint --dt 0.25 "
