@@ -1,6 +1,6 @@
 #pragma once
 // Shared helpers for the tests: scenes from inline XML or scenes/, and runs collected in memory.
-#include "engine/simulation.hpp"
+#include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
 
 #include <fstream>

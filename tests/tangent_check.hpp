@@ -2,7 +2,7 @@
 // Finite-difference checks of tangents shared by the tests: central differences of a residual
 // and the worst row mismatch against an analytic tangent, entries of different units weighed
 // by the dofs' magnitudes.
-#include "engine/model.hpp"
+#include "engine/core/model.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // symmetry implies.
 #include "support.hpp"
 
-#include "engine/method.hpp"
+#include "engine/stepping/method.hpp"
 
 #include <gtest/gtest.h>
 

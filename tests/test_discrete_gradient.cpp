@@ -1,7 +1,7 @@
 // Discrete gradients (eem-primer.md section 2) on smooth functions and on the element laws, and
 // the laws' own jets and thermodynamics, which the discrete gradients and the tangents rely on.
-#include "engine/discrete_gradient.hpp"
-#include "models/element_laws.hpp"
+#include "engine/core/discrete_gradient.hpp"
+#include "models/lumped/element_laws.hpp"
 
 #include <gtest/gtest.h>
 

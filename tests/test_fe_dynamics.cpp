@@ -6,7 +6,7 @@
 #include "support.hpp"
 #include "tangent_check.hpp"
 
-#include "engine/method.hpp"
+#include "engine/stepping/method.hpp"
 #include "models/fe/material.hpp"
 
 #include <Eigen/SparseLU>

@@ -1,6 +1,6 @@
 // Finite-strain material laws (stress and tangent against finite differences of the energy, the small-strain limit)
 // and the Gonzalez discrete stress: directionality, second-order consistency, symmetry and its linearisation.
-#include "engine/discrete_gradient.hpp"
+#include "engine/core/discrete_gradient.hpp"
 #include "models/fe/discrete_stress.hpp"
 #include "models/fe/material.hpp"
 

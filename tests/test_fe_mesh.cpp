@@ -2,10 +2,10 @@
 // surfaces; Gmsh 2.2 and 4.1 files read into the same mesh with named sets and outward faces, and every kind of
 // malformed file is rejected naming the file and line; VTK output parses as XML with the right sizes; the boundary
 // renders to a PNG.
-#include "engine/input_error.hpp"
-#include "models/fe/gmsh_reader.hpp"
+#include "engine/core/input_error.hpp"
+#include "models/scene/gmsh_reader.hpp"
 #include "models/fe/mesh_generators.hpp"
-#include "models/fe/vtk_writer.hpp"
+#include "tools/output/vtk_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <tinyxml2.h>

@@ -1,10 +1,10 @@
 // metriplex bench: a work-precision sweep of one scene. One-step schemes over a list of steps,
 // IDA over a list of tolerances, each against one cached reference solution (IDA at rtol 1e-12).
-#include "commands.hpp"
-#include "plots.hpp"
+#include "tools/commands.hpp"
+#include "tools/output/plots.hpp"
 
-#include "engine/input_error.hpp"
-#include "engine/method.hpp"
+#include "engine/core/input_error.hpp"
+#include "engine/stepping/method.hpp"
 #include "models/scene/scene_loader.hpp"
 
 #include <fmt/format.h>

@@ -1,8 +1,8 @@
 // metriplex: run scenes with EEM and standard integrators from the command line.
 // Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure.
-#include "commands.hpp"
+#include "tools/commands.hpp"
 
-#include "engine/input_error.hpp"
+#include "engine/core/input_error.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>

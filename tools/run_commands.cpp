@@ -1,11 +1,11 @@
 // metriplex run and metriplex compare.
-#include "commands.hpp"
-#include "frames_csv.hpp"
-#include "history_csv.hpp"
-#include "solid_frames.hpp"
+#include "tools/commands.hpp"
+#include "tools/output/frames_csv.hpp"
+#include "tools/output/history_csv.hpp"
+#include "tools/output/solid_frames.hpp"
 
-#include "engine/input_error.hpp"
-#include "engine/method.hpp"
+#include "engine/core/input_error.hpp"
+#include "engine/stepping/method.hpp"
 #include "models/scene/scene_loader.hpp"
 
 #include <fmt/format.h>

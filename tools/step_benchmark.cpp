@@ -3,8 +3,8 @@
 // rigid links, and the tumbling L-block by mesh level (with the step split into assembly and
 // linear solve).
 // Reproduce and read the figures with docs/performance.md.
-#include "engine/condensed_solver.hpp"
-#include "engine/integrator.hpp"
+#include "engine/linear/condensed_solver.hpp"
+#include "engine/stepping/integrator.hpp"
 #include "models/scene/scene_loader.hpp"
 
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-#include "discrete_stress.hpp"
+#include "models/fe/discrete_stress.hpp"
 
 
 #include <algorithm>

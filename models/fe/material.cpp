@@ -1,4 +1,4 @@
-#include "material.hpp"
+#include "models/fe/material.hpp"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "mesh.hpp"
+#include "models/fe/mesh.hpp"
 
 #include <algorithm>
 #include <stdexcept>

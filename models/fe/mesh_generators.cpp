@@ -1,4 +1,4 @@
-#include "mesh_generators.hpp"
+#include "models/fe/mesh_generators.hpp"
 
 #include <functional>
 #include <numeric>

@@ -1,6 +1,6 @@
 #pragma once
 // Structured hexahedral meshes built in code: a box and the tumbling L-block benchmark.
-#include "mesh.hpp"
+#include "models/fe/mesh.hpp"
 
 namespace mpx {
 

@@ -1,4 +1,4 @@
-#include "shape_functions.hpp"
+#include "models/fe/shape_functions.hpp"
 
 #include <cmath>
 #include <stdexcept>

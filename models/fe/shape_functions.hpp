@@ -1,7 +1,7 @@
 #pragma once
 // Shape functions and Gauss rules of the solid cells (trilinear hexahedron, linear
 // tetrahedron), and their gradients mapped to the reference configuration of one cell.
-#include "mesh.hpp"
+#include "models/fe/mesh.hpp"
 
 #include <Eigen/Dense>
 

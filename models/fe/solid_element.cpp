@@ -1,6 +1,6 @@
-#include "solid_element.hpp"
+#include "models/fe/solid_element.hpp"
 
-#include "discrete_stress.hpp"
+#include "models/fe/discrete_stress.hpp"
 
 namespace mpx {
 

@@ -10,10 +10,10 @@
 // The viscous strain follows (Gamma' - Gamma)/dt = S_v/eta, dissipating S_v:S_v/eta.
 // Local dofs: node positions, their velocity (momentum) rows, 6 viscous strain components
 // (xx, yy, zz, xy, yz, xz) per quadrature point.
-#include "material.hpp"
-#include "shape_functions.hpp"
+#include "models/fe/material.hpp"
+#include "models/fe/shape_functions.hpp"
 
-#include "engine/component.hpp"
+#include "engine/core/component.hpp"
 
 #include <memory>
 #include <optional>

@@ -1,4 +1,4 @@
-#include "solid_inertia.hpp"
+#include "models/fe/solid_inertia.hpp"
 
 namespace mpx {
 

@@ -6,9 +6,9 @@
 //   momentum (all nodes)      sum_b M_ab (v_b' - v_b)/dt - f_a  rate form: sum_b M_ab vdot_b - f_a
 // with f_a = g sum_b M_ab, whose potential -f_a.x_a is part of the energy. The kinetic energy
 // v.Mv/2, momentum sum M_ab v_b and angular momentum sum M_ab x_a x v_b are exact sums.
-#include "shape_functions.hpp"
+#include "models/fe/shape_functions.hpp"
 
-#include "engine/component.hpp"
+#include "engine/core/component.hpp"
 
 namespace mpx {
 

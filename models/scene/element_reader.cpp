@@ -1,4 +1,4 @@
-#include "element_reader.hpp"
+#include "models/scene/element_reader.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -2,8 +2,8 @@
 // Typed, validated access to the attributes of one XML element. Every value is checked
 // (finite numbers, signs, vector length) and every attribute must be read: finish() rejects
 // the ones left over, so a misspelt attribute is an error, not a silent default.
-#include "engine/component.hpp"
-#include "engine/input_error.hpp"
+#include "engine/core/component.hpp"
+#include "engine/core/input_error.hpp"
 
 #include <tinyxml2.h>
 

@@ -1,10 +1,10 @@
-#include "scene_compiler.hpp"
+#include "models/scene/scene_compiler.hpp"
 
-#include "engine/method.hpp"
-#include "models/damper.hpp"
-#include "models/external_force.hpp"
-#include "models/fixed_temperature.hpp"
-#include "models/inertia.hpp"
+#include "engine/stepping/method.hpp"
+#include "models/lumped/damper.hpp"
+#include "models/lumped/external_force.hpp"
+#include "models/thermal/fixed_temperature.hpp"
+#include "models/multibody/inertia.hpp"
 
 #include <algorithm>
 

@@ -3,14 +3,14 @@
 // <metriplex> document in order and builds the model's components with their global dofs.
 // scene_compiler.cpp holds the settings and the point-mass/thermal elements,
 // scene_multibody.cpp the rigid bodies, joints, joint forces and torques.
-#include "element_reader.hpp"
-#include "scene_loader.hpp"
+#include "models/scene/element_reader.hpp"
+#include "models/scene/scene_loader.hpp"
 
-#include "engine/time_function.hpp"
+#include "engine/core/time_function.hpp"
 #include "models/fe/mesh.hpp"
-#include "models/heat_link.hpp"
-#include "models/joint_builder.hpp"
-#include "models/lumped_element.hpp"
+#include "models/thermal/heat_link.hpp"
+#include "models/multibody/joint_builder.hpp"
+#include "models/lumped/lumped_element.hpp"
 
 #include <tinyxml2.h>
 

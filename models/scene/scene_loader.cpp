@@ -1,7 +1,7 @@
-#include "scene_loader.hpp"
+#include "models/scene/scene_loader.hpp"
 
-#include "scene_compiler.hpp"
-#include "urdf_scene.hpp"
+#include "models/scene/scene_compiler.hpp"
+#include "models/scene/urdf_scene.hpp"
 
 #include <filesystem>
 #include <fstream>

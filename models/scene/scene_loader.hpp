@@ -1,12 +1,12 @@
 #pragma once
 // Compile an XML scene (docs/scene-format.md) into a Model. Scene-level defaults (step,
 // end time, integrator, solver settings) come back beside the model.
-#include "engine/integrator.hpp"
-#include "engine/model.hpp"
+#include "engine/stepping/integrator.hpp"
+#include "engine/core/model.hpp"
 #include "models/fe/mesh.hpp"
 #include "models/fe/solid_element.hpp"
-#include "models/joint_coordinate.hpp"
-#include "models/lumped_element.hpp"
+#include "models/multibody/joint_coordinate.hpp"
+#include "models/lumped/lumped_element.hpp"
 
 #include <memory>
 #include <optional>

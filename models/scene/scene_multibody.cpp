@@ -1,8 +1,8 @@
-#include "scene_compiler.hpp"
+#include "models/scene/scene_compiler.hpp"
 
-#include "models/external_torque.hpp"
-#include "models/inertia.hpp"
-#include "models/joint_force.hpp"
+#include "models/multibody/external_torque.hpp"
+#include "models/multibody/inertia.hpp"
+#include "models/multibody/joint_force.hpp"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,9 +1,9 @@
 // The finite-element elements of a scene: <solid> and the loads, supports and joints that
 // refer to its named surfaces (docs/scene-format.md).
-#include "scene_compiler.hpp"
+#include "models/scene/scene_compiler.hpp"
 
-#include "models/external_force.hpp"
-#include "models/fe/gmsh_reader.hpp"
+#include "models/lumped/external_force.hpp"
+#include "models/scene/gmsh_reader.hpp"
 #include "models/fe/mesh_generators.hpp"
 #include "models/fe/shape_functions.hpp"
 #include "models/fe/solid_inertia.hpp"

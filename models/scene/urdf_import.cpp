@@ -1,6 +1,6 @@
-#include "urdf_import.hpp"
+#include "models/scene/urdf_import.hpp"
 
-#include "engine/input_error.hpp"
+#include "engine/core/input_error.hpp"
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>

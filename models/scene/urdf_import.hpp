@@ -4,7 +4,7 @@
 // configuration: an <anchor> for the ground, a <body> per link with mass, a <joint> per moving
 // or fixed URDF joint and a joint damper per joint with <dynamics>. The scene compiler then
 // reads them like hand-written elements.
-#include "engine/component.hpp"
+#include "engine/core/component.hpp"
 
 #include <tinyxml2.h>
 

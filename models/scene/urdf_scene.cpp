@@ -1,7 +1,7 @@
-#include "urdf_scene.hpp"
+#include "models/scene/urdf_scene.hpp"
 
-#include "element_reader.hpp"
-#include "urdf_import.hpp"
+#include "models/scene/element_reader.hpp"
+#include "models/scene/urdf_import.hpp"
 
 #include <filesystem>
 #include <map>

@@ -1,0 +1,36 @@
+#include "engine/core/model.hpp"
+
+#include <algorithm>
+
+namespace mpx {
+
+Model::Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
+             std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
+             std::vector<PrescribedMotion> prescribedMotions)
+    : layout_(layout),
+      thermalVariable_(thermalVariable),
+      components_(std::move(components)),
+      thermalNodeNames_(std::move(thermalNodeNames)),
+      initialState_(std::move(initialState)),
+      dofScale_(std::move(dofScale)),
+      prescribedMotions_(std::move(prescribedMotions)) {
+  // couplings read what the others publish: evaluate them last
+  std::stable_partition(components_.begin(), components_.end(),
+                        [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); });
+}
+
+void Model::measure(const Eigen::VectorXd& z, Measures& out) const {
+  out.energy = out.entropy = out.constraintViolation = 0.0;
+  out.momentum.setZero();
+  out.angularMomentum.setZero();
+  out.nodeTemperature.assign(thermalNodeNames_.size(), 0.0);
+  for (const auto& component : components_) component->measure(z.data(), out);
+}
+
+Workspace Model::makeWorkspace() const {
+  Workspace ws;
+  ws.nodes.resize(thermalNodeNames_.size());
+  return ws;
+}
+
+}  // namespace mpx

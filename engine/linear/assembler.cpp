@@ -1,0 +1,114 @@
+#include "engine/linear/assembler.hpp"
+
+#include "engine/linear/sparse_entry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace mpx {
+
+Assembler::Assembler(const Model& model) {
+  const int n = model.layout().total();
+  residual_ = Eigen::VectorXd::Zero(n);
+  rowScale_ = Eigen::VectorXd::Zero(n);
+
+  // pattern: the coupled pairs of each component's dofs, plus the diagonal
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) entries.emplace_back(i, i, 0.0);
+  for (const auto& component : model.components()) {
+    const auto& dofs = component->dofs();
+    if (dofs.size() > static_cast<std::size_t>(kMaxLocalDofs))
+      throw std::logic_error("component '" + component->name() + "' touches more than kMaxLocalDofs dofs");
+    for (std::size_t i = 0; i < dofs.size(); ++i)
+      for (std::size_t j = 0; j < dofs.size(); ++j)
+        if (component->couples(static_cast<int>(i), static_cast<int>(j))) entries.emplace_back(dofs[i], dofs[j], 0.0);
+  }
+  tangent_.resize(n, n);
+  tangent_.setFromTriplets(entries.begin(), entries.end());
+  tangent_.makeCompressed();
+
+  // scatter map: position of (row, col) in the compressed column `col`
+  const int* outer = tangent_.outerIndexPtr();
+  const int* inner = tangent_.innerIndexPtr();
+  for (const auto& component : model.components()) {
+    const auto& dofs = component->dofs();
+    std::vector<std::pair<int, int>> map;
+    for (std::size_t j = 0; j < dofs.size(); ++j)
+      for (std::size_t i = 0; i < dofs.size(); ++i) {
+        if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
+        map.emplace_back(static_cast<int>(i + j * dofs.size()), findEntry(tangent_, dofs[i], dofs[j]));
+      }
+    scatterMap_.push_back(std::move(map));
+  }
+  // rows of the prescribed velocities, to be overwritten
+  const auto& prescribed = model.prescribedMotions();
+  prescribedRowEntries_.assign(prescribed.size(), {});
+  std::vector<int> prescribedIndex(n, -1);
+  for (std::size_t k = 0; k < prescribed.size(); ++k) prescribedIndex[prescribed[k].dof] = static_cast<int>(k);
+  for (int e = 0; e < outer[n]; ++e)
+    if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
+  for (const PrescribedMotion& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
+  localResidual_.assign(kMaxLocalDofs, 0.0);
+  localTangent_.assign(kMaxLocalDofs * kMaxLocalDofs, 0.0);
+}
+
+void Assembler::clear() {
+  residual_.setZero();
+  std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
+  flows_ = Flows{};
+}
+
+void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
+                        double weight) {
+  double* values = tangent_.valuePtr();
+  for (int i = 0; i < local.n; ++i) residual_[dofs[i]] += weight * local.r[i];
+  for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
+}
+
+void Assembler::replaceRow(std::size_t k, int dof, double value, double diagonal, double velocity) {
+  flows_.externalWork += residual_[dof] * velocity;
+  double* values = tangent_.valuePtr();
+  for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
+  values[prescribedDiagonal_[k]] = diagonal;
+  residual_[dof] = value;
+}
+
+void Assembler::imposeStepMotions(const Model& model, const double* zOld, const double* zNew, double t, double dt) {
+  const auto& prescribed = model.prescribedMotions();
+  for (std::size_t k = 0; k < prescribed.size(); ++k) {
+    const PrescribedMotion& p = prescribed[k];
+    const double change = p.amplitude * (p.profile(t + dt) - p.profile(t));
+    const double meanVelocity = 0.5 * (zOld[p.dof] + zNew[p.dof]);
+    if (p.displacement)
+      replaceRow(k, p.dof, meanVelocity - change / dt, 0.5, meanVelocity);
+    else
+      replaceRow(k, p.dof, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, meanVelocity);
+  }
+}
+
+void Assembler::imposeRateMotions(const Model& model, const double* z, const double* zdot, double t, double beta) {
+  const auto& prescribed = model.prescribedMotions();
+  for (std::size_t k = 0; k < prescribed.size(); ++k) {
+    const PrescribedMotion& p = prescribed[k];
+    replaceRow(k, p.dof, zdot[p.dof] - p.amplitude * p.profile.slope(t), beta, z[p.dof]);
+  }
+}
+
+void Assembler::updateRowScale(const Eigen::VectorXd& stateScale) {
+  rowScale_.setZero();
+  for (int col = 0; col < tangent_.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(tangent_, col); it; ++it)
+      rowScale_[it.row()] += std::abs(it.value()) * stateScale[col];
+}
+
+double Assembler::relativeResidualNorm() const {
+  double norm = 0.0;
+  for (Eigen::Index i = 0; i < residual_.size(); ++i) {
+    if (!std::isfinite(residual_[i])) return INFINITY;
+    if (residual_[i] != 0.0) norm = std::max(norm, std::abs(residual_[i]) / rowScale_[i]);
+  }
+  return norm;
+}
+
+}  // namespace mpx

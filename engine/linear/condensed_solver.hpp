@@ -1,0 +1,73 @@
+#pragma once
+// The Newton system of a step, K dz = -r, solved with the velocity increments eliminated.
+// Every position dof q_i has a kinematic row (q_i' - q_i)/dt - (v_i + v_i')/2 (or its rate
+// form) whose only velocity entry is d_i = dR_qi/dv_i. That row gives
+//   dv_i = -(r_qi + sum_c K(q_i, c) dz_c) / d_i          (c: all dofs but velocities)
+// and substituting it leaves a system in positions, thermal, internal and multiplier
+// unknowns only, with the momentum rows in place of the kinematic ones: half the size for
+// mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
+// Scenes whose pattern does not have this structure are solved whole. Internal variables that
+// split into small independent groups (per quadrature point, per Maxwell element) are then
+// eliminated as well (engine/group_elimination), so that what is factorised is the system of
+// positions, thermal unknowns and multipliers.
+#include "engine/linear/group_elimination.hpp"
+#include "engine/core/layout.hpp"
+#include "engine/linear/sparse_lu.hpp"
+
+#include <Eigen/Sparse>
+
+#include <memory>
+#include <vector>
+
+namespace mpx {
+
+class CondensedSolver {
+ public:
+  // `pattern`: the fixed pattern of every tangent this solver will see.
+  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern);
+
+  // Factorise the condensed form of `tangent`, which must stay alive and unchanged until the
+  // next factorize (solve reads it). Returns false if it is singular.
+  bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
+  // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
+  void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
+  // Unknowns of the system actually factorised.
+  int condensedSize() const { return static_cast<int>(factorised().rows()); }
+
+ private:
+  // One term K(j, v_i) K(q_i, c) / d_i of the condensed entry (j, c).
+  struct ProductTerm {
+    int velocityEntry, kinematicEntry, pivotEntry, reducedEntry;
+  };
+  // An entry of a kinematic row q_i off its velocity: column c (a kept dof) and its place in K.
+  struct RowEntry {
+    int column, entry;
+  };
+  bool buildCondensation(const Eigen::SparseMatrix<double>& pattern);
+  void condenseVelocities(const Eigen::SparseMatrix<double>& tangent);
+  // Solve the velocity-condensed system in place, through the internal elimination if any.
+  void solveVelocityCondensed(Eigen::VectorXd& rhs);
+  // Index of a kept row / column in the condensed system (velocity row v_i takes q_i's place).
+  int reducedRow(int row) const { return row - velocities_; }
+  int reducedColumn(int column) const { return column < velocities_ ? column : column - velocities_; }
+  // The matrix after velocity condensation (the tangent itself without it).
+  const Eigen::SparseMatrix<double>& velocityCondensed() const { return velocities_ > 0 ? reduced_ : *tangent_; }
+  const Eigen::SparseMatrix<double>& factorised() const {
+    return internal_.active() ? internal_.reduced() : velocities_ > 0 ? reduced_ : *pattern_;
+  }
+
+  int velocities_ = 0;  // 0: solved whole
+  const Eigen::SparseMatrix<double>* pattern_;
+  const Eigen::SparseMatrix<double>* tangent_ = nullptr;
+  Eigen::SparseMatrix<double> reduced_;
+  std::vector<std::pair<int, int>> directEntries_;  // (entry in K, entry in the condensed matrix)
+  std::vector<ProductTerm> productTerms_;
+  std::vector<int> pivotEntry_;                      // per q_i: position of d_i in K
+  std::vector<std::vector<RowEntry>> kinematicRows_;  // per q_i
+  Eigen::VectorXd reducedRhs_;
+  GroupElimination internal_;
+  Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
+  std::unique_ptr<SparseLu> lu_;
+};
+
+}  // namespace mpx

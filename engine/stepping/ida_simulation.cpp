@@ -1,0 +1,294 @@
+#include "engine/stepping/ida_simulation.hpp"
+
+#include "engine/linear/assembler.hpp"
+
+#include <Eigen/SparseLU>
+
+#include <ida/ida.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace mpx {
+
+namespace {
+
+// Models up to this many unknowns use a dense Jacobian; larger ones sparse KLU.
+constexpr int kLargestDenseSystem = 64;
+// The boundary-energy accumulators appended to the state: dissipated, external work, boundary heat.
+constexpr int kAccumulators = 3;
+// Absolute tolerance of the multipliers (forces, in the model's units) in IDA's Newton test;
+// they are left out of the error test, and the GGL multiplier mu stays at round-off, so a
+// tolerance tied to the positions' would ask Newton to resolve noise.
+constexpr double kMultiplierTolerance = 1.0;
+
+// Owns the IDA memory, vectors, Jacobian and linear solver for one run.
+class IdaProblem {
+ public:
+  IdaProblem(const Model& model, const IdaOptions& options);
+  ~IdaProblem();
+  IdaProblem(const IdaProblem&) = delete;
+  IdaProblem& operator=(const IdaProblem&) = delete;
+
+  // Consistent initial rates (and multipliers) for the initial state; false on failure.
+  bool initialise(double firstOutput);
+  // Integrate to tout; false on failure (see error()).
+  bool advanceTo(double tout);
+  const double* state() const { return N_VGetArrayPointer(y_); }
+  const std::string& error() const { return error_; }
+  IdaStatistics statistics() const;
+
+ private:
+  static int residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* self);
+  static int jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* self,
+                      N_Vector, N_Vector, N_Vector);
+  static void errorHandler(int code, const char* module, const char* function, char* message, void* self);
+  void evaluate(double t, N_Vector y, N_Vector yp, double cj);
+  // Index-2 models (GGL constraints): solve the differential rows together with the time
+  // derivatives of the algebraic rows for the rates and the multipliers, then hand them to IDA.
+  bool initialiseAlgebraic();
+  void check(int flag, const char* call) const;
+
+  const Model& model_;
+  Assembler assembler_;
+  Workspace workspace_;
+  int modelSize_;
+  bool dense_;
+  SUNContext context_ = nullptr;
+  N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr, atol_ = nullptr;
+  SUNMatrix jacobian_ = nullptr;
+  SUNLinearSolver linearSolver_ = nullptr;
+  void* ida_ = nullptr;
+  std::string error_;
+};
+
+IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
+    : model_(model),
+      assembler_(model),
+      workspace_(model.makeWorkspace()),
+      modelSize_(model.layout().total()),
+      dense_(model.layout().total() + kAccumulators <= kLargestDenseSystem) {
+  const int n = modelSize_ + kAccumulators;
+  check(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
+  y_ = N_VNew_Serial(n, context_);
+  yp_ = N_VNew_Serial(n, context_);
+  id_ = N_VNew_Serial(n, context_);
+  atol_ = N_VNew_Serial(n, context_);
+  double* y = N_VGetArrayPointer(y_);
+  double* atol = N_VGetArrayPointer(atol_);
+  for (int i = 0; i < n; ++i) {
+    y[i] = i < modelSize_ ? model.initialState()[i] : 0.0;
+    atol[i] = options.absoluteTolerance * (i < modelSize_ ? model.dofScale()[i] : 1.0);
+    if (i < modelSize_ && model.layout().blockOf(i) == Block::Multiplier) atol[i] = kMultiplierTolerance;
+  }
+  N_VConst(0.0, yp_);
+  // multipliers are algebraic (and left out of the error test: the GGL form has index 2);
+  // every other unknown of the rate form is differential
+  double* id = N_VGetArrayPointer(id_);
+  const Layout& layout = model.layout();
+  for (int i = 0; i < n; ++i) id[i] = i < modelSize_ && layout.blockOf(i) == Block::Multiplier ? 0.0 : 1.0;
+
+  ida_ = IDACreate(context_);
+  check(IDASetErrHandlerFn(ida_, errorHandler, this), "IDASetErrHandlerFn");
+  check(IDAInit(ida_, residual, 0.0, y_, yp_), "IDAInit");
+  check(IDASVtolerances(ida_, options.relativeTolerance, atol_), "IDASVtolerances");
+  check(IDASetUserData(ida_, this), "IDASetUserData");
+  check(IDASetId(ida_, id_), "IDASetId");
+  check(IDASetSuppressAlg(ida_, SUNTRUE), "IDASetSuppressAlg");
+  check(IDASetMaxOrd(ida_, options.maxOrder), "IDASetMaxOrd");
+  check(IDASetMaxNumSteps(ida_, 1000000), "IDASetMaxNumSteps");
+
+  const auto nonZeros = static_cast<sunindextype>(assembler_.tangent().nonZeros() + kAccumulators);
+  jacobian_ = dense_ ? SUNDenseMatrix(n, n, context_) : SUNSparseMatrix(n, n, nonZeros, CSC_MAT, context_);
+  linearSolver_ = dense_ ? SUNLinSol_Dense(y_, jacobian_, context_) : SUNLinSol_KLU(y_, jacobian_, context_);
+  check(IDASetLinearSolver(ida_, linearSolver_, jacobian_), "IDASetLinearSolver");
+  check(IDASetJacFn(ida_, jacobian), "IDASetJacFn");
+}
+
+IdaProblem::~IdaProblem() {
+  IDAFree(&ida_);
+  if (linearSolver_) SUNLinSolFree(linearSolver_);
+  if (jacobian_) SUNMatDestroy(jacobian_);
+  for (N_Vector v : {y_, yp_, id_, atol_})
+    if (v) N_VDestroy(v);
+  if (context_) SUNContext_Free(&context_);
+}
+
+void IdaProblem::check(int flag, const char* call) const {
+  if (flag < 0) throw std::runtime_error(std::string("SUNDIALS ") + call + " failed: " + error_);
+}
+
+void IdaProblem::errorHandler(int code, const char*, const char* function, char* message, void* self) {
+  if (code < 0) static_cast<IdaProblem*>(self)->error_ = std::string(function) + ": " + message;
+}
+
+void IdaProblem::evaluate(double t, N_Vector y, N_Vector yp, double cj) {
+  assembler_.clear();
+  assembler_.addRate(model_, workspace_, {N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, 1.0, cj}, 1.0);
+  assembler_.imposeRateMotions(model_, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, cj);
+}
+
+int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* user) {
+  auto& self = *static_cast<IdaProblem*>(user);
+  self.evaluate(t, y, yp, 0.0);
+  double* out = N_VGetArrayPointer(r);
+  const Eigen::VectorXd& modelResidual = self.assembler_.residual();
+  std::copy(modelResidual.data(), modelResidual.data() + self.modelSize_, out);
+  // accumulators: D' = dissipated power, W' = external power, Q' = boundary heat rate
+  const double* rate = N_VGetArrayPointer(yp) + self.modelSize_;
+  const Flows& flows = self.assembler_.flows();
+  out[self.modelSize_] = rate[0] - flows.dissipated;
+  out[self.modelSize_ + 1] = rate[1] - flows.externalWork;
+  out[self.modelSize_ + 2] = rate[2] - flows.boundaryHeat;
+  // a non-finite residual is recoverable: IDA retries with a smaller step
+  return modelResidual.allFinite() ? 0 : 1;
+}
+
+int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* user,
+                         N_Vector, N_Vector, N_Vector) {
+  auto& self = *static_cast<IdaProblem*>(user);
+  self.evaluate(t, y, yp, cj);
+  const Eigen::SparseMatrix<double>& K = self.assembler_.tangent();
+  const int n = self.modelSize_;
+  // the accumulator rows enter with cj on the diagonal only: their dependence on z is left
+  // out (IDA's Newton is a modified Newton; nothing else depends on the accumulators)
+  if (self.dense_) {
+    SUNMatZero(J);
+    for (int col = 0; col < n; ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it)
+        SM_ELEMENT_D(J, it.row(), col) = it.value();
+    for (int a = 0; a < kAccumulators; ++a) SM_ELEMENT_D(J, n + a, n + a) = cj;
+    return 0;
+  }
+  sunindextype* colStart = SUNSparseMatrix_IndexPointers(J);
+  sunindextype* rowIndex = SUNSparseMatrix_IndexValues(J);
+  double* values = SUNSparseMatrix_Data(J);
+  std::copy(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, colStart);
+  std::copy(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), rowIndex);
+  std::copy(K.valuePtr(), K.valuePtr() + K.nonZeros(), values);
+  for (int a = 0; a < kAccumulators; ++a) {
+    const auto entry = static_cast<sunindextype>(K.nonZeros() + a);
+    rowIndex[entry] = n + a;
+    values[entry] = cj;
+    colStart[n + a + 1] = entry + 1;
+  }
+  return 0;
+}
+
+bool IdaProblem::initialise(double firstOutput) {
+  if (model_.layout().has(Block::Multiplier)) return initialiseAlgebraic();
+  return IDACalcIC(ida_, IDA_YA_YDP_INIT, firstOutput) >= 0 && IDAGetConsistentIC(ida_, y_, yp_) >= 0;
+}
+
+bool IdaProblem::initialiseAlgebraic() {
+  // IDACalcIC handles index 1 only. The rate form is linear in the rates and the multipliers,
+  // so one linear solve from (rates, multipliers) = 0 is exact: differential rows F = 0, and
+  // for each algebraic row (no rate, no multiplier in it) dF/dz . zdot = 0.
+  const Layout& layout = model_.layout();
+  const int n = modelSize_;
+  N_VConst(0.0, yp_);
+  double* y = N_VGetArrayPointer(y_);
+  for (int i = layout.offset(Block::Multiplier); i < n; ++i) y[i] = 0.0;
+  evaluate(0.0, y_, yp_, 0.0);  // alpha = 1, beta = 0: F and dF/dz
+  const Eigen::VectorXd residual = assembler_.residual();
+  const Eigen::SparseMatrix<double> dFdz = assembler_.tangent();
+  assembler_.clear();
+  assembler_.addRate(model_, workspace_, {y, N_VGetArrayPointer(yp_), 0.0, 0.0, 1.0}, 1.0);
+  const Eigen::SparseMatrix<double>& dFdzdot = assembler_.tangent();
+
+  // unknown j: the rate of a differential dof, or the value of a multiplier
+  auto algebraic = [&](int i) { return layout.blockOf(i) == Block::Multiplier; };
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::VectorXd rhs = -residual;
+  // a row is algebraic when it has no rate in it
+  std::vector<bool> hasRate(n, false);
+  for (int col = 0; col < n; ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
+      if (it.value() != 0.0) hasRate[it.row()] = true;
+  for (int col = 0; col < n; ++col) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdz, col); it; ++it) {
+      if (!hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());  // dF_a/dz . zdot
+      if (hasRate[it.row()] && algebraic(col)) entries.emplace_back(it.row(), col, it.value());    // multipliers
+    }
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
+      if (hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());
+  }
+  for (int i = 0; i < n; ++i)
+    if (!hasRate[i]) rhs[i] = 0.0;
+  Eigen::SparseMatrix<double> system(n, n);
+  system.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(system);
+  if (lu.info() != Eigen::Success) {
+    error_ = "consistent initial conditions: singular system (redundant constraints or inconsistent initial state?)";
+    return false;
+  }
+  const Eigen::VectorXd solution = lu.solve(rhs);
+  double* yp = N_VGetArrayPointer(yp_);
+  for (int i = 0; i < n; ++i) (algebraic(i) ? y[i] : yp[i]) = solution[i];
+  return IDAReInit(ida_, 0.0, y_, yp_) >= 0;
+}
+
+bool IdaProblem::advanceTo(double tout) {
+  realtype reached = 0.0;
+  return IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0;
+}
+
+IdaStatistics IdaProblem::statistics() const {
+  IdaStatistics s;
+  IDAGetNumSteps(ida_, &s.steps);
+  IDAGetNumResEvals(ida_, &s.residualEvaluations);
+  IDAGetNumJacEvals(ida_, &s.jacobianEvaluations);
+  IDAGetNumNonlinSolvIters(ida_, &s.nonlinearIterations);
+  IDAGetNumErrTestFails(ida_, &s.errorTestFailures);
+  return s;
+}
+
+}  // namespace
+
+RunSummary simulateIda(const Model& model, const IdaOptions& options, const StepSink& sink,
+                       const ProgressSink& progress) {
+  RunSummary summary;
+  IdaProblem ida(model, options);
+  const int n = model.layout().total();
+  const auto outputs = static_cast<int>(std::ceil(options.tEnd / options.outputStep - 1e-9));
+  RunReporter reporter(model, summary, sink, progress, outputs);
+  auto fail = [&](int output, double t, const std::string& what) {
+    summary.failed = true;
+    summary.failedStep = output;
+    summary.failedTime = t;
+    summary.failure = what + ": " + ida.error();
+  };
+  // IDACalcIC takes its step scale from the first output time: keep that short
+  if (!ida.initialise(std::min(options.outputStep, 0.01 * options.tEnd)))
+    fail(0, 0.0, "consistent initial conditions failed");
+  long previousIterations = 0, previousErrorTestFailures = 0;
+  for (int k = 1; k <= outputs && !summary.failed; ++k) {
+    const double tout = k == outputs ? options.tEnd : k * options.outputStep;
+    if (!ida.advanceTo(tout)) {
+      fail(k, reporter.last().time, "IDASolve failed");
+      break;
+    }
+    // the model's unknowns, then the accumulated boundary energies
+    reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
+    const IdaStatistics stats = ida.statistics();
+    reporter.report(k, tout, {ida.state()[n], ida.state()[n + 1], ida.state()[n + 2]},
+                    static_cast<int>(stats.nonlinearIterations - previousIterations),
+                    static_cast<int>(stats.errorTestFailures - previousErrorTestFailures));
+    previousIterations = stats.nonlinearIterations;
+    previousErrorTestFailures = stats.errorTestFailures;
+  }
+  reporter.finish();
+  summary.ida = ida.statistics();
+  summary.newtonIterations = summary.ida->nonlinearIterations;
+  summary.cutbacks = static_cast<int>(summary.ida->errorTestFailures);
+  return summary;
+}
+
+}  // namespace mpx

@@ -1,0 +1,23 @@
+#pragma once
+// The SUNDIALS IDA baseline: the model's rate form F(t, z, zdot) = 0 (Component::rateLocal)
+// integrated by variable-order, variable-step BDF with the analytic Jacobian
+// dF/dz + cj dF/dzdot, dense for small models and sparse (KLU) for large ones. Energies that
+// cross the boundary are integrated as three extra unknowns (D' = dissipated power, ...).
+#include "engine/stepping/simulation.hpp"
+
+namespace mpx {
+
+struct IdaOptions {
+  double relativeTolerance = 1e-6;
+  double absoluteTolerance = 1e-8;  // times each dof's scale (Model::dofScale)
+  int maxOrder = 5;
+  double outputStep = 0.0;  // history rows at multiples of this
+  double tEnd = 0.0;
+};
+
+// Same contract as simulate(): step 0 is the initial state, one record per output time; the
+// summary carries IDA's statistics and, on failure, IDA's own message.
+RunSummary simulateIda(const Model& model, const IdaOptions& options, const StepSink& sink,
+                       const ProgressSink& progress = nullptr);
+
+}  // namespace mpx

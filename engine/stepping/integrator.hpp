@@ -1,0 +1,77 @@
+#pragma once
+// One-step integrators on a compiled model: the EEM discrete-gradient scheme and the standard
+// implicit midpoint and trapezoidal rules (derived from the components' rate form), solved by
+// Newton-Raphson with the consistent tangent, a backtracking line search on the residual and
+// a bounded step cut-back.
+#include "engine/linear/assembler.hpp"
+#include "engine/linear/condensed_solver.hpp"
+#include "engine/core/model.hpp"
+
+#include <Eigen/Dense>
+
+#include <string>
+#include <vector>
+
+namespace mpx {
+
+enum class Scheme { Eem, Midpoint, Trapezoidal };
+
+struct NewtonSettings {
+  double incrementTolerance = 1e-10;  // max |dz_i| / (|z_i| + scale_i)
+  double residualTolerance = 1e-8;    // max |R_i| / (sum of |terms| in R_i)
+  int maxIterations = 25;
+  int maxCutbacks = 6;  // each halves the step
+};
+
+// Energy crossing the boundary during one step (J); see Flows.
+struct StepEnergy {
+  double dissipated = 0.0;
+  double externalWork = 0.0;
+  double boundaryHeat = 0.0;
+};
+
+struct StepOutcome {
+  bool converged = false;
+  int iterations = 0;  // Newton iterations, all sub-steps
+  int cutbacks = 0;    // halvings needed
+  StepEnergy energy;
+  // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
+  // recovered Newton failure does not allocate
+  char failure[200] = "";
+};
+
+class Integrator {
+ public:
+  Integrator(const Model& model, Scheme scheme, NewtonSettings settings);
+
+  // Advance state z at time t by dt into zNew, halving the step up to maxCutbacks times
+  // when Newton fails. Allocates nothing.
+  StepOutcome advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew);
+
+  // Residual and tangent of the step zOld -> zNew (exposed for tangent tests).
+  Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
+  Scheme scheme() const { return scheme_; }
+
+ private:
+  // Midpoint or trapezoidal residual of the step from the components' rate form.
+  void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
+  bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
+                    StepOutcome& outcome);
+  bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
+  // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
+  // evaluated at zNew + step increment_ in trial_); 0 if none does.
+  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
+                    double residualNorm);
+
+  const Model& model_;
+  Scheme scheme_;
+  NewtonSettings settings_;
+  Assembler assembler_;
+  CondensedSolver solver_;
+  Workspace workspace_;
+  Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
+  int unknownsWithScale_;  // dofs before the multiplier block: those in the increment test
+  std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
+};
+
+}  // namespace mpx

@@ -1,0 +1,42 @@
+#pragma once
+// Integration methods by name, and one entry point that runs any of them on a model:
+// EEM (with the scene's or a forced thermal variable), implicit midpoint, trapezoidal, IDA.
+#include "engine/stepping/ida_simulation.hpp"
+#include "engine/core/model.hpp"
+#include "engine/stepping/simulation.hpp"
+
+#include <optional>
+#include <string>
+
+namespace mpx {
+
+struct Method {
+  std::string name;
+  bool ida = false;             // SUNDIALS IDA instead of a one-step scheme
+  Scheme scheme = Scheme::Eem;  // the one-step scheme otherwise
+  std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
+};
+
+// The names methodByName accepts, for messages.
+inline constexpr const char* kMethodNames = "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, ida";
+std::optional<Method> methodByName(const std::string& name);
+
+struct MethodParameters {
+  double dt = 0.0;  // step of one-step schemes; IDA's output interval
+  double tEnd = 0.0;
+  NewtonSettings newton;
+  double relativeTolerance = 1e-6;  // IDA
+  double absoluteTolerance = 1e-8;  // IDA, times each dof's scale
+  int maxOrder = 5;                 // IDA
+};
+
+// Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a
+// velocity (a displacement is imposed step by step through the mean velocity, which a rate form
+// cannot express).
+// `scene` names the scene file in the message.
+void checkMethodSupports(const Method& method, const Model& model, const std::string& scene);
+
+RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters,
+                     const StepSink& sink, const ProgressSink& progress = nullptr);
+
+}  // namespace mpx

@@ -1,0 +1,82 @@
+#include "engine/stepping/simulation.hpp"
+
+#include <cmath>
+
+namespace mpx {
+
+RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps)
+    : model_(model),
+      summary_(summary),
+      sink_(std::move(sink)),
+      progress_(std::move(progress)),
+      steps_(steps),
+      progressEvery_(std::max(1, steps / 100)),
+      state_(model.initialState()),
+      start_(std::chrono::steady_clock::now()) {
+  model_.measure(state_, measures_);
+  balance_ = EnergyBalance(measures_.energy);
+  previousEntropy_ = measures_.entropy;
+  record_.state = &state_;
+  record_.measures = &measures_;
+  sink_(record_);
+}
+
+void RunReporter::report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks) {
+  model_.measure(state_, measures_);
+  record_.step = step;
+  record_.time = time;
+  record_.dissipated = crossed.dissipated;
+  record_.externalWork = crossed.externalWork;
+  record_.boundaryHeat = crossed.boundaryHeat;
+  record_.newtonIterations = newtonIterations;
+  record_.cutbacks = cutbacks;
+  sink_(record_);
+
+  // conservation figures: the energy balance against t = 0, the smallest entropy increment
+  summary_.maxEnergyBalanceError =
+      std::max(summary_.maxEnergyBalanceError, balance_.relativeError(measures_.energy, crossed.dissipated,
+                                                                       crossed.externalWork, crossed.boundaryHeat));
+  const double entropyIncrement = measures_.entropy - previousEntropy_;
+  summary_.minEntropyIncrement = step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
+  previousEntropy_ = measures_.entropy;
+  summary_.steps = step;
+  if (progress_ && step % progressEvery_ == 0) progress_(static_cast<double>(step) / steps_);
+}
+
+void RunReporter::finish() {
+  summary_.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
+                    const ProgressSink& progress) {
+  RunSummary summary;
+  Integrator integrator(model, options.scheme, options.newton);
+  // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
+  const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
+  RunReporter reporter(model, summary, sink, progress, steps);
+  Eigen::VectorXd next(reporter.state().size());
+  StepEnergy crossed;
+  for (int n = 1; n <= steps; ++n) {
+    const double t = reporter.last().time;
+    const double dt = std::min(options.dt, options.tEnd - t);
+    const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next);
+    summary.newtonIterations += outcome.iterations;
+    summary.cutbacks += outcome.cutbacks;
+    if (!outcome.converged) {
+      summary.failed = true;
+      summary.failedStep = n;
+      summary.failedTime = t;
+      summary.failure = outcome.failure;
+      break;
+    }
+    reporter.state().swap(next);
+    crossed.dissipated += outcome.energy.dissipated;
+    crossed.externalWork += outcome.energy.externalWork;
+    crossed.boundaryHeat += outcome.energy.boundaryHeat;
+    reporter.report(n, n == steps ? options.tEnd : t + dt, crossed, outcome.iterations, outcome.cutbacks);
+  }
+  reporter.finish();
+  return summary;
+}
+
+}  // namespace mpx

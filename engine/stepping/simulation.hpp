@@ -1,0 +1,115 @@
+#pragma once
+// The time loop: advance a model with one integrator at a fixed step, report every step to a
+// sink, and summarise the run (cost, conservation, failure).
+#include "engine/stepping/integrator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace mpx {
+
+struct RunOptions {
+  Scheme scheme = Scheme::Eem;
+  double dt = 0.0;
+  double tEnd = 0.0;
+  NewtonSettings newton;
+};
+
+// What one step reports; energies that crossed the boundary are accumulated since t = 0.
+struct StepRecord {
+  int step = 0;
+  double time = 0.0;
+  const Eigen::VectorXd* state = nullptr;
+  const Measures* measures = nullptr;
+  double dissipated = 0.0;
+  double externalWork = 0.0;
+  double boundaryHeat = 0.0;
+  int newtonIterations = 0;
+  int cutbacks = 0;
+};
+
+// SUNDIALS IDA's counters for a run (see engine/ida_simulation.hpp).
+struct IdaStatistics {
+  long steps = 0;
+  long residualEvaluations = 0;
+  long jacobianEvaluations = 0;
+  long nonlinearIterations = 0;
+  long errorTestFailures = 0;
+};
+
+// The energy balance E + D - W - Q - E_0 of a run: the largest |balance| so far relative to the
+// largest of |E_0|, |E|, D, |W| and |Q| so far, so that a scene started from rest (E_0 = 0)
+// is judged against the energy its loads put in, not against its first tiny step.
+class EnergyBalance {
+ public:
+  explicit EnergyBalance(double initialEnergy) : initial_(initialEnergy), scale_(std::abs(initialEnergy)) {}
+  double relativeError(double energy, double dissipated, double externalWork, double boundaryHeat) {
+    scale_ = std::max({scale_, std::abs(energy), std::abs(dissipated), std::abs(externalWork), std::abs(boundaryHeat)});
+    largestError_ = std::max(largestError_, std::abs(energy + dissipated - externalWork - boundaryHeat - initial_));
+    return scale_ > 0.0 ? largestError_ / scale_ : largestError_;
+  }
+
+ private:
+  double initial_, scale_, largestError_ = 0.0;
+};
+
+struct RunSummary {
+  int steps = 0;
+  long newtonIterations = 0;
+  int cutbacks = 0;
+  double wallSeconds = 0.0;
+  // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy seen (EnergyBalance):
+  // energy drift net of dissipated energy D, external work W and boundary heat Q (the plain
+  // energy drift for an isolated system)
+  double maxEnergyBalanceError = 0.0;
+  double minEntropyIncrement = 0.0;  // min_n (S_n - S_{n-1})
+  std::optional<IdaStatistics> ida;  // set for IDA runs
+  bool failed = false;
+  int failedStep = 0;
+  double failedTime = 0.0;
+  std::string failure;
+};
+
+using StepSink = std::function<void(const StepRecord&)>;
+// Called with the fraction of the run done, at most about a hundred times.
+using ProgressSink = std::function<void(double)>;
+
+// What the time loops share: the current state, its measures and the record handed to the
+// sink; the summary's conservation figures (energy balance error, entropy increments) and
+// wall time; the progress bar. Constructing it reports the initial state as step 0.
+class RunReporter {
+ public:
+  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps);
+
+  // The state the next report() describes; loops advance it in place.
+  Eigen::VectorXd& state() { return state_; }
+  const StepRecord& last() const { return record_; }
+  // Report state() as `step` at `time`; `crossed` holds the energies crossed since t = 0.
+  void report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks);
+  // Record the wall time since construction in the summary.
+  void finish();
+
+ private:
+  const Model& model_;
+  RunSummary& summary_;
+  StepSink sink_;
+  ProgressSink progress_;
+  int steps_, progressEvery_;
+  Eigen::VectorXd state_;
+  Measures measures_;
+  StepRecord record_;
+  EnergyBalance balance_{0.0};
+  double previousEntropy_ = 0.0;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// Run from the model's initial state; step 0 reports the initial state. Stops at the first
+// step the integrator cannot complete (after its cut-backs) and reports it in the summary.
+RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
+                    const ProgressSink& progress = nullptr);
+
+}  // namespace mpx

@@ -1,0 +1,75 @@
+#pragma once
+// A lumped thermo-mechanical element: energy e(c, s, gamma) and entropy eta(c, s, gamma) of a
+// stretch invariant c = |x_b - x_a|^2 between two end points, an own thermal node s and an
+// internal (viscous) variable gamma, each optional. Thermo-springs, Maxwell elements (with or
+// without a thermal node), elastic springs and heat reservoirs are all this component with a
+// different law; one recipe (eem-primer.md section 4) serves both thermal variables:
+//   theta~ = D_s e / D_s eta,  f~ = D_c e - theta~ D_c eta,  g~ = -(D_gamma e - theta~ D_gamma eta)
+//   momentum:  f~ dc/dq(q_mid)          internal: nu (gamma' - gamma)/dt = g~
+//   thermal:   theta~ (eta' - eta)/dt = g~^2/nu + heat from links
+// with D the discrete gradient in an EEM step and the exact partials in the rate form.
+#include "models/lumped/element_laws.hpp"
+#include "models/lumped/two_point_geometry.hpp"
+
+#include <memory>
+#include <optional>
+
+namespace mpx {
+
+enum class DiscreteGradientForm { Partitioned, Gonzalez };
+
+// nu(theta) = nuRef exp(-activation (theta - thetaRef)); constant without a thermal node.
+struct Viscosity {
+  double reference = 1.0;
+  double activation = 0.0;
+  double referenceTemperature = 1.0;
+};
+
+struct LumpedElementSpec {
+  std::string name;
+  std::optional<std::pair<Endpoint, Endpoint>> ends;  // absent: no stretch (a reservoir)
+  std::shared_ptr<const ElementLaw> law;
+  int thermalDof = -1;   // global dof of s, -1: isothermal
+  int thermalNode = -1;  // node index published for heat links
+  int internalDof = -1;  // global dof of gamma, -1: no internal variable
+  Viscosity viscosity;
+  Vec3 argumentScale = Vec3::Ones();  // characteristic magnitudes of (c, s, gamma)
+  DiscreteGradientForm form = DiscreteGradientForm::Partitioned;
+};
+
+class LumpedElement final : public Component {
+ public:
+  explicit LumpedElement(LumpedElementSpec spec);
+
+  // writes momentum, thermal and internal rows, never the end points' kinematic rows
+  bool couples(int row, int) const override { return !geometry_ || !geometry_->isPosition(row); }
+  void measure(const double* z, Measures& out) const override;
+  void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+
+ private:
+  // Conjugate quantities and their derivatives with respect to the arguments (c, s, gamma).
+  struct Response {
+    double force = 0.0, theta = 0.0, drivingForce = 0.0, viscosity = 1.0;
+    Vec3 dForce = Vec3::Zero(), dTheta = Vec3::Zero(), dDrivingForce = Vec3::Zero(), dViscosity = Vec3::Zero();
+  };
+  static std::vector<int> collectDofs(const LumpedElementSpec& spec);
+  Vec3 arguments(const double* z) const;
+  Response respond(const DiscreteGradient& dEnergy, const DiscreteGradient& dEntropy) const;
+  // Rows over local dofs of d(c, s, gamma)/dz, c's at separation d.
+  void argumentRows(const Vec3& separation, LocalRow (&rows)[3]) const;
+  static LocalRow chain(const Vec3& dArguments, const LocalRow (&rows)[3]);
+  // Residual rows shared by both forms and the tangent terms through the response's
+  // derivatives (times zCoefficient): momentum f (2 d), internal nu gammaRate - g, thermal
+  // theta entropyRate - g^2/nu; also publishes the node temperature.
+  void addBalances(const Response& response, const LocalRow (&rows)[3], double zCoefficient,
+                   const Vec3& forceDirection, double gammaRate, double entropyRate, Workspace& ws,
+                   LocalSystem& out, Flows& flows) const;
+
+  LumpedElementSpec spec_;
+  std::optional<TwoPointGeometry> geometry_;
+  unsigned mask_ = 0;
+  int localThermal_ = -1, localInternal_ = -1;
+};
+
+}  // namespace mpx

@@ -1,0 +1,66 @@
+#pragma once
+// A force element on the coordinate of a revolute or prismatic joint: a spring, a Maxwell
+// branch (spring in series with a dashpot, internal variable gamma), a viscous damper and
+// smoothed Coulomb friction. The coordinate is a function of quadratic invariants I of the
+// positions (JointBuilder::coordinateInvariants), so the EEM forces are exact:
+//   energy     e(I, gamma), force D_I e . grad I(q_mid): revolute k (1 - cos(theta - theta0))
+//              + kb (1 - cos(theta - gamma)); prismatic k/2 (s - s0)^2 + k3/4 (s - s0)^4
+//              + kb/2 (s - gamma)^2; nu (gamma' - gamma)/dt = -D_gamma e dissipates
+//              (D_gamma e)^2 / nu;
+//   dissipation f = c dtheta/dt + F tanh(dtheta/(dt v_s)), force f D_I theta . grad I(q_mid),
+//              dissipated energy f dtheta >= 0 per step exactly,
+// with theta(I) taken in a chart centred on the step's start (no wrap-around). The dissipated
+// power leaves as `dissipated`, or heats a thermal node (a reservoir) when one is given, so an
+// isolated system keeps E exactly and produces entropy.
+#include "models/multibody/joint_coordinate.hpp"
+
+namespace mpx {
+
+struct JointForceSpec {
+  std::string name;
+  bool revolute = true;                 // revolute: invariants (u, v); prismatic: (s)
+  std::vector<int> positionDofs;        // q of the invariants
+  int velocityShift = 0;                // velocity dof = position dof + velocityShift
+  std::vector<QuadraticForm> invariants;
+  double stiffness = 0.0, rest = 0.0;   // spring
+  double cubicStiffness = 0.0;          // prismatic: k3 of k3/4 (s - s0)^4
+  double branchStiffness = 0.0, viscosity = 1.0;  // Maxwell branch (with internalDof)
+  int internalDof = -1;                 // gamma of the Maxwell branch, -1: none
+  double damping = 0.0;                 // viscous coefficient
+  double friction = 0.0, frictionVelocity = 1.0;  // smoothed Coulomb
+  int heatDof = -1;                     // thermal dof heated by the dissipation, -1: none
+};
+
+class JointForce final : public Component {
+ public:
+  explicit JointForce(JointForceSpec spec);
+
+  // local order q, v, heat, internal: writes every row but the kinematic ones
+  bool couples(int row, int) const override { return row >= static_cast<int>(spec_.positionDofs.size()); }
+  void measure(const double* z, Measures& out) const override;
+  void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+
+ private:
+  static std::vector<int> collectDofs(const JointForceSpec& spec);
+  ConstraintVector gather(const double* z, int shift) const;
+  // (I_0, I_1, gamma) of a state; unused slots are 0.
+  Vec3 arguments(const double* z) const;
+  // Stored energy e(I, gamma) with gradient and Hessian.
+  Jet energy(const Vec3& args) const;
+  // Generalised dissipative force for a coordinate rate, and its derivative.
+  double dissipativeForce(double rate, double* dForce) const;
+  // d(I_0, I_1, gamma)/dq at q: one row per argument slot, zero for gamma and unused slots.
+  using ArgumentJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxConstrainedDofs>;
+  ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;
+  unsigned mask() const;
+  // Send the dissipated power (with its tangent row) to the heat node, or to the flows.
+  void deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out,
+               Flows& flows) const;
+
+  JointForceSpec spec_;
+  int n_;  // number of constrained positions
+  int localHeat_, localInternal_;
+};
+
+}  // namespace mpx

@@ -1,0 +1,92 @@
+#include "models/multibody/quadratic_constraint.hpp"
+
+#include <cmath>
+
+namespace mpx {
+
+std::vector<int> QuadraticConstraint::collectDofs(const ConstraintSpec& spec) {
+  std::vector<int> dofs = spec.positionDofs;
+  for (int p : spec.positionDofs) dofs.push_back(p + spec.velocityShift);
+  // lambda_k then mu_k (augmented Lagrangian only)
+  if (spec.enforcement == Enforcement::AugmentedLagrangian)
+    for (std::size_t k = 0; k < 2 * spec.forms.size(); ++k) dofs.push_back(spec.firstMultiplierDof + static_cast<int>(k));
+  return dofs;
+}
+
+QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
+    : Component(spec.name, collectDofs(spec)),
+      spec_(std::move(spec)),
+      positionCount_(static_cast<int>(spec_.positionDofs.size())) {}
+
+ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
+  ConstraintVector q(positionCount_);
+  for (int i = 0; i < positionCount_; ++i) q[i] = z[spec_.positionDofs[i] + shift];
+  return q;
+}
+
+double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
+  return augmented() ? z[spec_.firstMultiplierDof + k] : 0.0;
+}
+
+void QuadraticConstraint::measure(const double* z, Measures& out) const {
+  const ConstraintVector q = gather(z, 0);
+  for (std::size_t k = 0; k < spec_.forms.size(); ++k) {
+    const double phi = spec_.forms[k].value(q);
+    out.energy += multiplier(z, k) * phi + 0.5 * spec_.stiffness * phi * phi;
+    out.constraintViolation = std::max(out.constraintViolation, std::abs(phi));
+  }
+}
+
+void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  const ConstraintVector q0 = gather(args.zOld, 0), q1 = gather(args.zNew, 0);
+  const ConstraintVector qMid = 0.5 * (q0 + q1);
+  const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  auto r = out.residual();
+  auto K = out.tangent();
+  for (int k = 0; k < m; ++k) {
+    const QuadraticForm& form = spec_.forms[k];
+    // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi
+    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.value(q0) + form.value(q1));
+    const ConstraintVector gradientMid = form.gradientAt(qMid);
+    r.segment(n, n) += force * gradientMid;
+    K.block(n, 0, n, n) += 0.5 * force * form.hessian +
+                           (0.5 * spec_.stiffness) * gradientMid * form.gradientAt(q1).transpose();
+    if (!augmented()) continue;
+    // lambda's row: the constraint at the end of the step; mu is not used by EEM (mu = 0)
+    const int lambda = 2 * n + k, mu = 2 * n + m + k;
+    K.block(n, lambda, n, 1) += gradientMid;
+    r[lambda] = form.value(q1);
+    K.block(lambda, 0, 1, n) = form.gradientAt(q1).transpose();
+    r[mu] = args.zNew[spec_.firstMultiplierDof + m + k];
+    K(mu, mu) = 1.0;
+  }
+}
+
+void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  const ConstraintVector q = gather(args.z, 0), v = gather(args.z, spec_.velocityShift);
+  const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  auto r = out.residual();
+  auto K = out.tangent();
+  for (int k = 0; k < m; ++k) {
+    const QuadraticForm& form = spec_.forms[k];
+    const double force = multiplier(args.z, k) + spec_.stiffness * form.value(q);
+    const ConstraintVector gradient = form.gradientAt(q);
+    r.segment(n, n) += force * gradient;
+    K.block(n, 0, n, n) += args.alpha * (force * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+    if (!augmented()) continue;
+    // GGL (index 2): M v' + (lambda + kappa Phi) G^T = f, q' - v + mu G^T = 0, Phi = 0, G v = 0
+    const int lambda = 2 * n + k, mu = 2 * n + m + k;
+    const double muValue = args.z[spec_.firstMultiplierDof + m + k];
+    K.block(n, lambda, n, 1) += args.alpha * gradient;
+    r.head(n) += muValue * gradient;
+    K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;
+    K.block(0, mu, n, 1) += args.alpha * gradient;
+    r[lambda] = form.value(q);
+    K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
+    r[mu] = gradient.dot(v);
+    K.block(mu, 0, 1, n) = args.alpha * (form.hessian * v).transpose();
+    K.block(mu, n, 1, n) = args.alpha * gradient.transpose();
+  }
+}
+
+}  // namespace mpx

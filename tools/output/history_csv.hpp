@@ -1,0 +1,31 @@
+#pragma once
+// DIR/history.csv: one row per step. Written to history.csv.part and renamed when the run
+// ends, so an interrupted run never leaves a file that looks complete; a solver failure is
+// kept up to the last good step and marked by a final comment line.
+#include "engine/core/model.hpp"
+#include "engine/stepping/simulation.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace mpx {
+
+class HistoryCsv {
+ public:
+  HistoryCsv(const std::filesystem::path& directory, const Model& model);
+  ~HistoryCsv();
+  HistoryCsv(const HistoryCsv&) = delete;
+  HistoryCsv& operator=(const HistoryCsv&) = delete;
+
+  void write(const StepRecord& record);
+  // Close and publish the file; a failed run gets its failure line first.
+  void finish(const RunSummary& summary);
+  std::filesystem::path path() const { return finalPath_; }
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::filesystem::path partPath_, finalPath_;
+};
+
+}  // namespace mpx

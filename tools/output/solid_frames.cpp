@@ -1,0 +1,75 @@
+#include "tools/output/solid_frames.hpp"
+
+#include <fmt/format.h>
+
+namespace mpx {
+
+namespace {
+// The six independent components xx, yy, zz, xy, yz, xz of a symmetric tensor.
+void appendSymmetric(const Mat3& t, std::vector<double>& out) {
+  out.insert(out.end(), {t(0, 0), t(1, 1), t(2, 2), t(0, 1), t(1, 2), t(0, 2)});
+}
+
+double vonMisesOf(const Mat3& sigma) {
+  const Mat3 deviator = sigma - sigma.trace() / 3 * Mat3::Identity();
+  return std::sqrt(1.5 * (deviator.array() * deviator.array()).sum());
+}
+}  // namespace
+
+SolidFrames::SolidFrames(const std::filesystem::path& directory, const CompiledScene& scene, double interval)
+    : directory_(directory), interval_(interval) {
+  for (const SolidOutput& solid : scene.solids) {
+    std::filesystem::create_directories(directory / solid.name);
+    series_.push_back({&solid, PvdSeries((directory / (solid.name + ".pvd")).string()), {}, {}});
+  }
+}
+
+void SolidFrames::write(const StepRecord& record) {
+  if (series_.empty()) return;
+  // frames at multiples of the interval (and at every step without one)
+  if (record.step > 0 && interval_ > 0.0 && record.time < nextOutput_ - 1e-9 * interval_) return;
+  nextOutput_ += interval_;
+  const double* z = record.state->data();
+  for (Series& s : series_) {
+    const SolidOutput& solid = *s.solid;
+    const Mesh& mesh = *solid.mesh;
+    VtkField displacement{"displacement", 3, {}}, velocity{"velocity", 3, {}};
+    s.positions.resize(mesh.nodes.size());
+    for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+      const int dof = solid.firstPositionDof + 3 * static_cast<int>(n);
+      s.positions[n] = Eigen::Map<const Vec3>(z + dof);
+      const Vec3 u = s.positions[n] - mesh.nodes[n];
+      displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
+      velocity.values.insert(velocity.values.end(), {z[dof + solid.velocityShift], z[dof + solid.velocityShift + 1],
+                                                     z[dof + solid.velocityShift + 2]});
+    }
+    VtkField stress{"cauchy_stress", 6, {}}, vonMises{"von_mises", 1, {}}, viscous{"viscous_strain", 6, {}};
+    for (const SolidElement* cell : solid.cells) {
+      const Mat3 sigma = cell->meanCauchyStress(z);
+      appendSymmetric(sigma, stress.values);
+      vonMises.values.push_back(vonMisesOf(sigma));
+      appendSymmetric(cell->meanViscousStrain(z), viscous.values);
+    }
+    const std::string file = fmt::format("{}/frame_{:05d}.vtu", solid.name, frame_);
+    writeVtu((directory_ / file).string(), mesh, s.positions, {displacement, velocity}, {stress, vonMises, viscous});
+    s.pvd.add(record.time, file);
+    s.pvd.write();
+    s.vonMises = vonMises.values;
+    s.time = record.time;
+  }
+  ++frame_;
+}
+
+void SolidFrames::finish() {
+  for (const Series& s : series_) {
+    const std::filesystem::path png = directory_ / (s.solid->name + ".png");
+    try {
+      renderSurfacePng(png.string(), *s.solid->mesh, s.positions, s.vonMises, "von Mises stress",
+                       fmt::format("{} at t = {:.4g}", s.solid->name, s.time));
+    } catch (const std::exception& error) {
+      fmt::print(stderr, "metriplex: warning: no picture of '{}': {}\n", s.solid->name, error.what());
+    }
+  }
+}
+
+}  // namespace mpx

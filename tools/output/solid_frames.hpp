@@ -1,0 +1,37 @@
+#pragma once
+// ParaView output of the finite-element solids of a run: DIR/<solid>.pvd listing
+// DIR/<solid>/frame_<k>.vtu (displacement and velocity at nodes; Cauchy stress, von Mises
+// stress and viscous strain per cell), one frame per output interval, and at the end a
+// picture of the last frame, DIR/<solid>.png, coloured by the von Mises stress.
+#include "engine/stepping/simulation.hpp"
+#include "tools/output/vtk_writer.hpp"
+#include "models/scene/scene_loader.hpp"
+
+#include <filesystem>
+
+namespace mpx {
+
+class SolidFrames {
+ public:
+  // interval <= 0: every step.
+  SolidFrames(const std::filesystem::path& directory, const CompiledScene& scene, double interval);
+
+  void write(const StepRecord& record);
+  // Render the last frame of each solid (a warning, not an error, if gnuplot fails).
+  void finish();
+
+ private:
+  struct Series {
+    const SolidOutput* solid;
+    PvdSeries pvd;
+    std::vector<Vec3> positions;  // of the last frame written
+    std::vector<double> vonMises;
+    double time = 0.0;
+  };
+  std::filesystem::path directory_;
+  double interval_, nextOutput_ = 0.0;
+  int frame_ = 0;
+  std::vector<Series> series_;
+};
+
+}  // namespace mpx
