@@ -75,7 +75,7 @@ LoadedBalance loadedBalance(const History& h) {
 
 // Mass of the scene's first solid: the momentum of the state moving it at unit speed along x.
 double solidMass(const CompiledScene& scene) {
-  const SolidOutput& solid = scene.solids.front();
+  const SolidPlacement& solid = scene.solids.front();
   VectorXd z = scene.model->initialState();
   z.segment(scene.model->layout().offset(Block::Velocity), scene.model->layout().size(Block::Velocity)).setZero();
   for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n) z[solid.firstPositionDof + 3 * n + solid.velocityShift] = 1.0;
@@ -85,7 +85,7 @@ double solidMass(const CompiledScene& scene) {
 }
 
 // Largest distance of the nodes of a solid's surface from their reference positions.
-double largestMotion(const std::vector<VectorXd>& states, const SolidOutput& solid, const std::string& surface) {
+double largestMotion(const std::vector<VectorXd>& states, const SolidPlacement& solid, const std::string& surface) {
   double motion = 0.0;
   for (const VectorXd& z : states)
     for (int n : solid.mesh->nodesOf(surface))
@@ -180,7 +180,7 @@ std::vector<Vec3> internalForces(const CompiledScene& scene, VectorXd z) {
   z.segment(model.layout().offset(Block::Velocity), model.layout().size(Block::Velocity)).setZero();
   Integrator integrator(model, Scheme::Eem, NewtonSettings{});
   const VectorXd& r = integrator.evaluate(z, z, 0.0, 0.1).residual();
-  const SolidOutput& solid = scene.solids.front();
+  const SolidPlacement& solid = scene.solids.front();
   std::vector<Vec3> forces;
   for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n)
     forces.push_back(r.segment<3>(solid.firstPositionDof + 3 * n + solid.velocityShift));
@@ -190,7 +190,7 @@ std::vector<Vec3> internalForces(const CompiledScene& scene, VectorXd z) {
 // The state with node n at x(X_n).
 template <class Map>
 VectorXd deformed(const CompiledScene& scene, const Map& map) {
-  const SolidOutput& solid = scene.solids.front();
+  const SolidPlacement& solid = scene.solids.front();
   VectorXd z = scene.model->initialState();
   for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n)
     z.segment<3>(solid.firstPositionDof + 3 * n) = map(solid.mesh->nodes[n]);
@@ -236,7 +236,7 @@ TEST(InternalForces, HaveNoResultantForceOrMomentInAGeneralDeformation) {
     return Vec3(X.x() + 0.1 * std::sin(X.y()) + 0.5, X.y() + 0.08 * X.x() * X.z(), X.z() - 0.05 * X.y() * X.y());
   });
   const std::vector<Vec3> forces = internalForces(scene, z);
-  const SolidOutput& solid = scene.solids.front();
+  const SolidPlacement& solid = scene.solids.front();
   Vec3 resultant = Vec3::Zero(), moment = Vec3::Zero();
   double largest = 0.0, reach = 0.0;
   for (std::size_t n = 0; n < forces.size(); ++n) {
@@ -357,7 +357,7 @@ TEST(ViscoelasticCantilever, ClampHoldsAndEnergyBalanceIsExactWhileItRelaxes) {
   const SceneRun r = runScene(loadScene(scenePath("viscoelastic_cantilever.xml")), Scheme::Eem, 0.02, 6.0);
   const History& h = r.history;
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  const SolidOutput& bar = r.scene.solids.front();
+  const SolidPlacement& bar = r.scene.solids.front();
   const double clampMotion = largestMotion(h.states, bar, "x0");
   const double peak = *std::max_element(h.energy.begin(), h.energy.end());
   const auto [error, scale] = loadedBalance(h);
@@ -379,7 +379,7 @@ TEST(TetrahedralBar, ClampHoldsAndEnergyMinusWorkIsExact) {
   const SceneRun r = runScene(loadScene(scenePath("tet_bar.xml")), Scheme::Eem, 0.01, 1.5);
   const History& h = r.history;
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  const SolidOutput& bar = r.scene.solids.front();
+  const SolidPlacement& bar = r.scene.solids.front();
   const double clampMotion = largestMotion(h.states, bar, "left");
   const auto [error, scale] = loadedBalance(h);
   const double balanceError = error / scale;
@@ -403,7 +403,7 @@ TEST(TetrahedralBar, IdaHoldsTheClampAndFollowsEem) {
                                        [&](const StepRecord& r) { ida.push_back(*r.state); });
   ASSERT_FALSE(summary.failed) << summary.failure;
   const History eem = run(*scene.model, Scheme::Eem, 1e-3, 1.0, scene.settings.newton);
-  const SolidOutput& bar = scene.solids.front();
+  const SolidPlacement& bar = scene.solids.front();
   const double clampMotion = largestMotion(ida, bar, "left");
   const int tip = bar.firstPositionDof + 3 * bar.mesh->nodesOf("right").front();
   const Vec3 idaTip = ida.back().segment<3>(tip), eemTip = eem.states.back().segment<3>(tip);
@@ -421,7 +421,7 @@ TEST(StretchedBar, EndFaceFollowsThePrescribedDisplacementAndTheBalanceIsExact) 
   const SceneRun r = runScene(loadScene(scenePath("stretched_bar.xml")), Scheme::Eem, 0.02, 3.0);
   const History& h = r.history;
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  const SolidOutput& bar = r.scene.solids.front();
+  const SolidPlacement& bar = r.scene.solids.front();
   double offTrack = 0.0;
   for (std::size_t n = 0; n < h.states.size(); ++n) {
     const double u = h.time[n] <= 2.0 ? 0.5 * std::sin(M_PI * h.time[n] / 2.0) : 0.0;
@@ -473,7 +473,7 @@ TEST(FlexiblePendulum, EnergyBalanceAndJointsHoldToRoundOff) {
   const double balanceError = driftAfter(energyBalance(h), 0, potentialScale);
   const double violation = maxViolation(*r.scene.model, h);
   // how far the free end (x = 2) fell: the link did swing
-  const SolidOutput& link = r.scene.solids.front();
+  const SolidPlacement& link = r.scene.solids.front();
   const int tipY = link.firstPositionDof + 3 * link.mesh->nodesOf("x1").front() + 1;
   const double drop = h.states.front()[tipY] - h.states.back()[tipY];
   std::printf("flexible pendulum, EEM dt 0.005 to t = 0.5: |E + D - E0| %.2e m g L, max constraint violation %.2e; "

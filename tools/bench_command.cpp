@@ -189,7 +189,7 @@ int benchCommand(const BenchRequest& request) {
   std::vector<double> tolerances = request.tolerances;
   if (tolerances.empty()) tolerances = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
   const std::filesystem::path out =
-      request.out.empty() ? std::filesystem::path("out") / (settings.name + "-bench") : std::filesystem::path(request.out);
+      request.out.empty() ? std::filesystem::path("out") / (own.name + "-bench") : std::filesystem::path(request.out);
 
   std::filesystem::create_directories(out);
   const FinalState referenceState = reference(*own.model, sceneText, tEnd, out);
@@ -235,7 +235,7 @@ int benchCommand(const BenchRequest& request) {
         series.push_back({fmt::format(method.ida ? "{} rtol {:g}" : "{} dt {:g}", method.name, method.ida ? r.rtol : r.dt),
                           r.series});
   }
-  renderPlots(out, settings.name, tEnd, workPrecision, series);
+  renderPlots(out, own.name, tEnd, workPrecision, series);
   fmt::print("wrote {}/work_precision.csv, work_precision.png, energy_error.png, entropy.png\n", out.string());
   return 0;
 }

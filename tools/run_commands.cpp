@@ -78,7 +78,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.maxOrder = request.maxOrder;
   if (method->ida) parameters.dt = request.outputStep.value_or(parameters.dt);
   std::filesystem::path out = request.out.empty()
-                                  ? std::filesystem::path("out") / (scene.settings.name + "-" + outSuffix)
+                                  ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
                                   : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
   return {*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
@@ -97,7 +97,7 @@ RunResult execute(const PreparedRun& run) {
                                frames.write(r);
                                solids.write(r);
                              },
-                             progressBar(run.scene.settings.name + " " + run.method.name));
+                             progressBar(run.scene.name + " " + run.method.name));
   history.finish(result.summary);
   frames.finish();
   solids.finish();

@@ -6,20 +6,20 @@
 
 namespace mpx {
 
-ElementReader::ElementReader(const tinyxml2::XMLElement& element, const std::string& file)
-    : element_(element), file_(file) {}
+ElementReader::ElementReader(const ElementSpec& element) : element_(element) {}
 
 void ElementReader::fail(const std::string& message) const {
-  std::string where = std::string("<") + element_.Name();
-  if (const char* name = element_.Attribute("name")) where += std::string(" name=\"") + name + "\"";
-  throw InputError(file_, element_.GetLineNum(), where + ">: " + message);
+  std::string what = "<" + element_.tag;
+  if (const std::string* name = element_.find("name")) what += " name=\"" + *name + "\"";
+  throw InputError(element_.where.describe() + ": " + what + ">: " + message);
 }
 
-bool ElementReader::has(const char* attribute) const { return element_.Attribute(attribute) != nullptr; }
+bool ElementReader::has(const char* attribute) const { return element_.find(attribute) != nullptr; }
 
 const char* ElementReader::raw(const char* attribute) {
   read_.insert(attribute);
-  return element_.Attribute(attribute);
+  const std::string* value = element_.find(attribute);
+  return value ? value->c_str() : nullptr;
 }
 
 std::string ElementReader::text(const char* attribute) {
@@ -27,8 +27,7 @@ std::string ElementReader::text(const char* attribute) {
   if (value) return value;
   // name what is there, so a misspelt attribute is easy to spot
   std::string present;
-  for (const tinyxml2::XMLAttribute* a = element_.FirstAttribute(); a; a = a->Next())
-    present += std::string(present.empty() ? "" : ", ") + a->Name();
+  for (const auto& [name, value] : element_.attributes) present += (present.empty() ? "" : ", ") + name;
   fail(std::string("missing required attribute '") + attribute + "' (attributes given: " +
        (present.empty() ? "none" : present) + ")");
 }
@@ -116,8 +115,8 @@ Eigen::Quaterniond ElementReader::orientation(const char* attribute) {
 }
 
 void ElementReader::finish() const {
-  for (const tinyxml2::XMLAttribute* a = element_.FirstAttribute(); a; a = a->Next())
-    if (!read_.count(a->Name())) fail(std::string("unknown attribute '") + a->Name() + "'");
+  for (const auto& [name, value] : element_.attributes)
+    if (!read_.count(name)) fail("unknown attribute '" + name + "'");
 }
 
 }  // namespace mpx

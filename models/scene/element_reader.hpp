@@ -1,11 +1,10 @@
 #pragma once
-// Typed, validated access to the attributes of one XML element. Every value is checked
+// Typed, validated access to the attributes of one scene element. Every value is checked
 // (finite numbers, signs, vector length) and every attribute must be read: finish() rejects
 // the ones left over, so a misspelt attribute is an error, not a silent default.
 #include "engine/core/component.hpp"
 #include "engine/core/input_error.hpp"
-
-#include <tinyxml2.h>
+#include "models/scene/scene_spec.hpp"
 
 #include <set>
 #include <string>
@@ -15,7 +14,7 @@ namespace mpx {
 
 class ElementReader {
  public:
-  ElementReader(const tinyxml2::XMLElement& element, const std::string& file);
+  explicit ElementReader(const ElementSpec& element);
 
   bool has(const char* attribute) const;
   std::string text(const char* attribute);
@@ -38,15 +37,16 @@ class ElementReader {
   [[noreturn]] void fail(const std::string& message) const;
   // Reject attributes that were never read.
   void finish() const;
-  const std::string& file() const { return file_; }
-  int line() const { return element_.GetLineNum(); }
+  const ElementSpec& element() const { return element_; }
+  const std::string& tag() const { return element_.tag; }
+  // Where the element came from, e.g. "scene.xml:12", for messages that name it.
+  std::string where() const { return element_.where.describe(); }
 
  private:
   const char* raw(const char* attribute);
   double parseNumber(const char* attribute, const std::string& token) const;
 
-  const tinyxml2::XMLElement& element_;
-  std::string file_;
+  const ElementSpec& element_;
   std::set<std::string> read_;
 };
 

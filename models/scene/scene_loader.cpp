@@ -1,7 +1,7 @@
 #include "models/scene/scene_loader.hpp"
 
-#include "models/scene/scene_compiler.hpp"
 #include "models/scene/urdf_scene.hpp"
+#include "models/scene/xml_scene.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -11,37 +11,92 @@ namespace mpx {
 
 namespace {
 
-CompiledScene compileDocument(tinyxml2::XMLDocument& document, const std::string& label,
-                              std::optional<ThermalVariable> thermalVariable) {
-  if (document.Error())
-    throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
-  const XMLElement* root = document.RootElement();
-  if (!root) throw InputError(label, 1, "the file holds no XML element");
-  expandUrdfIncludes(document, label);
-  return SceneCompiler(*root, label, thermalVariable).compile();
+// Position scale of a scene without any length (e.g. only thermal nodes).
+constexpr double kDefaultLength = 1.0;
+
+void checkSettings(const SceneSpec& scene) {
+  if (!(scene.settings.dt > 0.0) || !(scene.settings.tEnd > 0.0))
+    throw InputError(scene.label + ": the simulation needs dt > 0 and t_end > 0");
+}
+
+// The state layout: each element's declared dofs, in element order within each block.
+Layout layoutOf(const std::vector<DofDemand>& demands, std::vector<DofDemand>& firsts) {
+  DofDemand total;
+  for (const DofDemand& d : demands) {
+    firsts.push_back(total);
+    total.positions += d.positions;
+    total.thermal += d.thermal;
+    total.internal += d.internal;
+    total.multipliers += d.multipliers;
+  }
+  return Layout({total.positions, total.positions, total.thermal, total.internal, total.multipliers});
+}
+
+// Newton's increment scales: a length for positions, length per run time for velocities.
+void setMechanicalScales(SceneBuild& build, double tEnd) {
+  const double length = build.positionScale > 0.0 ? build.positionScale : kDefaultLength;
+  for (int i = 0; i < build.layout.size(Block::Position); ++i) {
+    const int p = build.layout.dof(Block::Position, i), v = build.layout.dof(Block::Velocity, i);
+    build.scale[p] = std::max(build.scale[p], length);
+    build.scale[v] = std::max(std::abs(build.state[v]), length / tEnd);
+  }
 }
 
 }  // namespace
 
-CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable) {
-  // a URDF alone is a scene with default settings
-  if (std::filesystem::path(path).extension() == ".urdf") {
-    tinyxml2::XMLDocument document;
-    writeUrdfScene(document, path);
-    return compileDocument(document, path, thermalVariable);
+CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable> thermalVariable) {
+  checkSettings(scene);
+  SceneBuild build(scene, thermalVariable.value_or(scene.settings.thermalVariable));
+
+  // pass 1: what every element needs from the state
+  std::vector<const ElementKind*> kinds;
+  std::vector<DofDemand> demands;
+  for (const ElementSpec& element : scene.elements) {
+    ElementReader in(element);
+    const ElementKind* kind = findElementKind(element.tag);
+    if (!kind) in.fail("unknown element (the elements a scene may hold: " + elementTags() + ")");
+    kinds.push_back(kind);
+    demands.push_back(kind->declare ? kind->declare(in, build) : DofDemand{});
   }
+  std::vector<DofDemand> firsts;
+  build.allocate(layoutOf(demands, firsts));
+
+  // pass 2: every element builds from the dofs it declared, and takes all of them
+  for (std::size_t k = 0; k < scene.elements.size(); ++k) {
+    ElementReader in(scene.elements[k]);
+    DofRange dofs(build.layout, firsts[k], demands[k]);
+    kinds[k]->build(in, build, dofs);
+    in.finish();
+    dofs.checkAllTaken(in.where() + ": <" + in.tag() + ">");
+  }
+  if (build.layout.total() == 0)
+    throw InputError(SourceLocation{scene.label, scene.line, 0}.describe() +
+                     ": <metriplex>: the scene has nothing to integrate (no mass, body, solid, thermal element "
+                     "or reservoir)");
+  setMechanicalScales(build, scene.settings.tEnd);
+  auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
+                                       build.thermalNodeNames, build.state, build.scale,
+                                       std::move(build.prescribedMotions));
+  return {scene.name, scene.settings, std::move(model), std::move(build.bodyFrames), std::move(build.jointCoordinates),
+          std::move(build.solids)};
+}
+
+SceneSpec readScene(const std::string& path) {
+  if (std::filesystem::path(path).extension() == ".urdf") return readUrdfScene(path);
   std::ifstream file(path);
   if (!file) throw InputError(path + ": cannot open the scene file");
   std::stringstream text;
   text << file.rdbuf();
-  return loadSceneText(text.str(), path, thermalVariable);
+  return readXmlScene(text.str(), path);
+}
+
+CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable) {
+  return compileScene(readScene(path), thermalVariable);
 }
 
 CompiledScene loadSceneText(const std::string& text, const std::string& label,
                             std::optional<ThermalVariable> thermalVariable) {
-  tinyxml2::XMLDocument document;
-  document.Parse(text.c_str(), text.size());
-  return compileDocument(document, label, thermalVariable);
+  return compileScene(readXmlScene(text, label), thermalVariable);
 }
 
 }  // namespace mpx

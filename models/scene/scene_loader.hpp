@@ -1,12 +1,11 @@
 #pragma once
-// Compile an XML scene (docs/scene-format.md) into a Model. Scene-level defaults (step,
-// end time, integrator, solver settings) come back beside the model.
-#include "engine/stepping/integrator.hpp"
+// From a scene to a Model: read a scene file (XML or URDF) into a SceneSpec, or build the
+// spec in code, then compile it. Scene-level defaults (step, end time, integrator, solver
+// settings) come back beside the model, with what output writers need to find bodies,
+// joints and solids in the state.
 #include "engine/core/model.hpp"
-#include "models/fe/mesh.hpp"
-#include "models/fe/solid_element.hpp"
-#include "models/multibody/joint_coordinate.hpp"
-#include "models/lumped/lumped_element.hpp"
+#include "models/scene/scene_build.hpp"
+#include "models/scene/scene_spec.hpp"
 
 #include <memory>
 #include <optional>
@@ -14,44 +13,23 @@
 
 namespace mpx {
 
-struct SceneSettings {
-  std::string name;
-  double dt = 0.0;
-  double tEnd = 0.0;
-  std::string integrator = "eem";
-  ThermalVariable thermalVariable = ThermalVariable::Temperature;  // what the scene declares
-  DiscreteGradientForm discreteGradient = DiscreteGradientForm::Partitioned;
-  NewtonSettings newton;
-};
-
-// A rigid body's pose in a state: centre of mass at firstPositionDof, orientation
-// D(t) * directorsToBody with D(t) = [d1 d2 d3] (the body frame as declared in the scene).
-struct BodyFrame {
-  std::string name;
-  int firstPositionDof;
-  Eigen::Matrix3d directorsToBody;
-};
-
-// A finite-element solid in the state: node n's position at firstPositionDof + 3 n, its
-// velocity velocityShift further; its cells (in mesh order) for stresses and output.
-struct SolidOutput {
-  std::string name;
-  std::shared_ptr<const Mesh> mesh;
-  int firstPositionDof;
-  int velocityShift;
-  std::vector<const SolidElement*> cells;
-};
-
 struct CompiledScene {
+  std::string name;
   SceneSettings settings;
   std::unique_ptr<Model> model;
   std::vector<BodyFrame> bodies;
   std::vector<JointCoordinate> joints;  // revolute and prismatic joints, for joints.csv
-  std::vector<SolidOutput> solids;
+  std::vector<SolidPlacement> solids;
 };
 
 // Throws InputError (file, line, element, what is wrong) on any invalid input. When
 // thermalVariable is given it overrides the scene's choice (e.g. --integrator eem-entropy).
+CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable> thermalVariable = std::nullopt);
+
+// Read a scene file: a .urdf alone, or a <metriplex> XML scene.
+SceneSpec readScene(const std::string& path);
+
+// readScene then compileScene.
 CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable = std::nullopt);
 // The same from XML text; `label` stands for the file name in messages.
 CompiledScene loadSceneText(const std::string& text, const std::string& label,

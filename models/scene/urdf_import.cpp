@@ -2,13 +2,14 @@
 
 #include "engine/core/input_error.hpp"
 
+#include <tinyxml2.h>
+
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -32,17 +33,9 @@ Pose toEigen(const urdf::Pose& p) {
   return pose;
 }
 
-// Space-separated, with 17 significant digits: the scene reads back exactly these values.
-std::string numbers(std::initializer_list<double> values) {
-  std::string text;
-  for (const double value : values) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.17g", value);
-    text += (text.empty() ? "" : " ") + std::string(buffer);
-  }
-  return text;
-}
-std::string numbers(const Vec3& v) { return numbers({v.x(), v.y(), v.z()}); }
+// Space-separated numbers for messages.
+std::string numbers(const Vec3& v) { return AttributeValue(v).text(); }
+std::string number(double value) { return AttributeValue(value).text(); }
 
 // 'a', 'b', 'c' for messages.
 std::string quotedList(const std::vector<std::string>& names) {
@@ -93,6 +86,11 @@ class UrdfFile {
 
   const std::string& path() const { return path_; }
   const std::string& text() const { return text_; }
+  // Line of <kind name="name">, 0 if unknown.
+  int line(const std::string& kind, const std::string& name) const {
+    const auto found = lines_.find(key(kind, name));
+    return found == lines_.end() ? 0 : found->second;
+  }
 
   // Throw an InputError at <kind name="name">, kind "link" or "joint".
   [[noreturn]] void fail(const std::string& kind, const std::string& name, const std::string& message) const {
@@ -150,8 +148,8 @@ struct LinkState {
 class UrdfTranslator {
  public:
   UrdfTranslator(const UrdfFile& file, const urdf::ModelInterface& robot, const UrdfImportOptions& options,
-                 tinyxml2::XMLElement& after)
-      : file_(file), robot_(robot), options_(options), last_(&after) {}
+                 SceneSpec& scene)
+      : file_(file), robot_(robot), options_(options), scene_(scene) {}
 
   void translate();
 
@@ -170,13 +168,13 @@ class UrdfTranslator {
   void addDynamics(const urdf::Joint& joint);
   void reportIgnored() const;
   std::string sceneName(const std::string& urdfName) const { return options_.prefix + urdfName; }
-  // A new element named `urdfName` (prefixed) after the previous one.
-  tinyxml2::XMLElement& emit(const char* tag, const std::string& urdfName);
+  // A new scene element named `urdfName` (prefixed), made from the URDF's <kind name="source">.
+  ElementSpec& emit(const char* tag, const std::string& urdfName, const char* kind, const std::string& source);
 
   const UrdfFile& file_;
   const urdf::ModelInterface& robot_;
   const UrdfImportOptions& options_;
-  tinyxml2::XMLElement* last_;
+  SceneSpec& scene_;
   std::map<std::string, std::string> parentJoint_;  // reached link -> joint it was reached through
   std::vector<std::string> limitedJoints_, ignoredDynamics_;
 };
@@ -213,22 +211,22 @@ void UrdfTranslator::checkNames() const {
 }
 
 std::string UrdfTranslator::addRoot(const urdf::Link& root, const LinkState& state) {
-  const std::string origin = numbers(state.frame.translation());
+  const Vec3 origin = state.frame.translation();
   // the world-link idiom: a massless root is the ground itself
   if (massless(root)) {
     if (options_.floating) file_.fail("link", root.name, "a floating root link needs an <inertial> with positive mass");
-    emit("anchor", root.name).SetAttribute("position", origin.c_str());
+    emit("anchor", root.name, "link", root.name).set("position", origin);
     return sceneName(root.name);
   }
   addBody(root, state);
   // a root with mass is held by a fixed joint to an anchor at its frame
   if (!options_.floating) {
-    emit("anchor", root.name + ".ground").SetAttribute("position", origin.c_str());
-    tinyxml2::XMLElement& joint = emit("joint", root.name + ".fixed");
-    joint.SetAttribute("type", "fixed");
-    joint.SetAttribute("a", sceneName(root.name + ".ground").c_str());
-    joint.SetAttribute("b", sceneName(root.name).c_str());
-    joint.SetAttribute("anchor", origin.c_str());
+    emit("anchor", root.name + ".ground", "link", root.name).set("position", origin);
+    emit("joint", root.name + ".fixed", "link", root.name)
+        .set("type", "fixed")
+        .set("a", sceneName(root.name + ".ground"))
+        .set("b", sceneName(root.name))
+        .set("anchor", origin);
   }
   return sceneName(root.name);
 }
@@ -306,7 +304,7 @@ bool UrdfTranslator::massless(const urdf::Link& link) {
 void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
   const urdf::Inertial& i = *link.inertial;
   if (!(i.mass > 0.0) || !std::isfinite(i.mass))
-    file_.fail("link", link.name, "mass must be positive and finite, got " + numbers({i.mass}));
+    file_.fail("link", link.name, "mass must be positive and finite, got " + number(i.mass));
   Eigen::Matrix3d tensor;
   tensor << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
   checkInertia(link, tensor);
@@ -315,13 +313,13 @@ void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
   const Vec3 centre = inertialFrame.translation();
   const Eigen::Quaterniond q(inertialFrame.linear());
   const Vec3 velocity = state.originVelocity + state.angularVelocity.cross(centre - state.frame.translation());
-  tinyxml2::XMLElement& body = emit("body", link.name);
-  body.SetAttribute("mass", i.mass);
-  body.SetAttribute("inertia", numbers({i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz}).c_str());
-  body.SetAttribute("position", numbers(centre).c_str());
-  body.SetAttribute("orientation", numbers({q.w(), q.x(), q.y(), q.z()}).c_str());
-  body.SetAttribute("velocity", numbers(velocity).c_str());
-  body.SetAttribute("angular_velocity", numbers(state.angularVelocity).c_str());
+  emit("body", link.name, "link", link.name)
+      .set("mass", i.mass)
+      .set("inertia", std::vector<double>{i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz})
+      .set("position", centre)
+      .set("orientation", q)
+      .set("velocity", velocity)
+      .set("angular_velocity", state.angularVelocity);
 }
 
 // A director body's "masses" (J_j + J_k - J_i)/2 must be positive: principal moments need the
@@ -338,15 +336,14 @@ void UrdfTranslator::checkInertia(const urdf::Link& link, const Eigen::Matrix3d&
 }
 
 void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child) {
-  tinyxml2::XMLElement& element = emit("joint", joint.name);
-  element.SetAttribute("type", sceneJointType(joint));
-  element.SetAttribute("a", parent.carrier.c_str());
-  element.SetAttribute("b", child.carrier.c_str());
-  element.SetAttribute("anchor", numbers(child.frame.translation()).c_str());
-  if (joint.type != urdf::Joint::FIXED)
-    element.SetAttribute("axis", numbers(child.frame.linear() * unitAxis(joint)).c_str());
+  ElementSpec& element = emit("joint", joint.name, "joint", joint.name)
+                             .set("type", sceneJointType(joint))
+                             .set("a", parent.carrier)
+                             .set("b", child.carrier)
+                             .set("anchor", Vec3(child.frame.translation()));
+  if (joint.type != urdf::Joint::FIXED) element.set("axis", Vec3(child.frame.linear() * unitAxis(joint)));
   // joints.csv then reports the URDF's own joint coordinate
-  if (hasCoordinate(joint)) element.SetAttribute("coordinate", initialState(joint).position);
+  if (hasCoordinate(joint)) element.set("coordinate", initialState(joint).position);
 }
 
 void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
@@ -361,11 +358,11 @@ void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
     ignoredDynamics_.push_back(joint.name);
     return;
   }
-  tinyxml2::XMLElement& damper = emit("joint_force", joint.name + ".damping");
-  damper.SetAttribute("joint", sceneName(joint.name).c_str());
-  damper.SetAttribute("damping", joint.dynamics->damping);
-  damper.SetAttribute("friction", joint.dynamics->friction);
-  damper.SetAttribute("friction_velocity", kFrictionVelocity);
+  emit("joint_force", joint.name + ".damping", "joint", joint.name)
+      .set("joint", sceneName(joint.name))
+      .set("damping", joint.dynamics->damping)
+      .set("friction", joint.dynamics->friction)
+      .set("friction_velocity", kFrictionVelocity);
 }
 
 void UrdfTranslator::reportIgnored() const {
@@ -376,20 +373,19 @@ void UrdfTranslator::reportIgnored() const {
                            " are ignored (joint forces act on revolute, continuous and prismatic joints only)");
 }
 
-tinyxml2::XMLElement& UrdfTranslator::emit(const char* tag, const std::string& urdfName) {
-  tinyxml2::XMLElement* element = last_->GetDocument()->NewElement(tag);
-  element->SetAttribute("name", sceneName(urdfName).c_str());
-  last_->Parent()->InsertAfterChild(last_, element);
-  last_ = element;
-  return *element;
+ElementSpec& UrdfTranslator::emit(const char* tag, const std::string& urdfName, const char* kind,
+                                  const std::string& source) {
+  ElementSpec& element = scene_.add(tag, {{"name", sceneName(urdfName)}});
+  element.where = {file_.path(), file_.line(kind, source), static_cast<int>(scene_.elements.size())};
+  return element;
 }
 
 }  // namespace
 
-void insertUrdfElements(const std::string& path, const UrdfImportOptions& options, tinyxml2::XMLElement& after) {
+void appendUrdfElements(const std::string& path, const UrdfImportOptions& options, SceneSpec& scene) {
   const UrdfFile file(path);
   const urdf::ModelInterfaceSharedPtr robot = parse(file);
-  UrdfTranslator(file, *robot, options, after).translate();
+  UrdfTranslator(file, *robot, options, scene).translate();
 }
 
 }  // namespace mpx

@@ -5,8 +5,7 @@
 // or fixed URDF joint and a joint damper per joint with <dynamics>. The scene compiler then
 // reads them like hand-written elements.
 #include "engine/core/component.hpp"
-
-#include <tinyxml2.h>
+#include "models/scene/scene_spec.hpp"
 
 #include <map>
 #include <string>
@@ -27,9 +26,10 @@ struct UrdfImportOptions {
   std::string prefix;  // put before every element name, so a robot can be included twice
 };
 
-// Validate the URDF at `path` and insert its scene elements after `after`, in an order the
-// compiler accepts (every reference declared above its use). Throws InputError naming the
-// URDF file and, where there is one, the line of the offending <link> or <joint>.
-void insertUrdfElements(const std::string& path, const UrdfImportOptions& options, tinyxml2::XMLElement& after);
+// Validate the URDF at `path` and append its scene elements to `scene`, in an order the
+// compiler accepts (every reference declared above its use); each element's location is the
+// URDF line of the <link> or <joint> it comes from. Throws InputError naming the URDF file
+// and, where there is one, the line of the offending <link> or <joint>.
+void appendUrdfElements(const std::string& path, const UrdfImportOptions& options, SceneSpec& scene);
 
 }  // namespace mpx

@@ -18,7 +18,7 @@ double vonMisesOf(const Mat3& sigma) {
 
 SolidFrames::SolidFrames(const std::filesystem::path& directory, const CompiledScene& scene, double interval)
     : directory_(directory), interval_(interval) {
-  for (const SolidOutput& solid : scene.solids) {
+  for (const SolidPlacement& solid : scene.solids) {
     std::filesystem::create_directories(directory / solid.name);
     series_.push_back({&solid, PvdSeries((directory / (solid.name + ".pvd")).string()), {}, {}});
   }
@@ -31,7 +31,7 @@ void SolidFrames::write(const StepRecord& record) {
   nextOutput_ += interval_;
   const double* z = record.state->data();
   for (Series& s : series_) {
-    const SolidOutput& solid = *s.solid;
+    const SolidPlacement& solid = *s.solid;
     const Mesh& mesh = *solid.mesh;
     VtkField displacement{"displacement", 3, {}}, velocity{"velocity", 3, {}};
     s.positions.resize(mesh.nodes.size());

@@ -22,7 +22,7 @@ class SolidFrames {
 
  private:
   struct Series {
-    const SolidOutput* solid;
+    const SolidPlacement* solid;
     PvdSeries pvd;
     std::vector<Vec3> positions;  // of the last frame written
     std::vector<double> vonMises;

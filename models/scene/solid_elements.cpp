@@ -1,19 +1,22 @@
-// The finite-element elements of a scene: <solid> and the loads, supports and joints that
-// refer to its named surfaces (docs/scene-format.md).
-#include "models/scene/scene_compiler.hpp"
-
-#include "models/lumped/external_force.hpp"
-#include "models/scene/gmsh_reader.hpp"
+// Finite-element solids and the loads, supports and joints that refer to their named surfaces
+// (docs/scene-format.md).
 #include "models/fe/mesh_generators.hpp"
 #include "models/fe/shape_functions.hpp"
 #include "models/fe/solid_inertia.hpp"
+#include "models/lumped/external_force.hpp"
+#include "models/scene/gmsh_reader.hpp"
+#include "models/scene/scene_build.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 namespace mpx {
 
 namespace {
+
+// Newton's scale of a viscous strain (dimensionless).
+constexpr double kViscousStrainScale = 1.0;
 
 // Where a solid's mesh comes from: a generator or a Gmsh file, moved by `offset`.
 struct MeshSource {
@@ -85,47 +88,30 @@ std::vector<Vec3> cellNodes(const Mesh& mesh, const Cell& cell) {
   return nodes;
 }
 
-}  // namespace
 
-void SceneCompiler::loadSolidMeshes() {
-  for (const XMLElement* e = root_.FirstChildElement("solid"); e; e = e->NextSiblingElement("solid")) {
-    ElementReader in(*e, file_);
-    const std::string name = in.text("name");
-    const MeshSource source = readMeshSource(in);
-    try {
-      solidMeshes_[name] = std::make_shared<const Mesh>(buildMesh(source, file_));
-    } catch (const std::invalid_argument& error) {
-      in.fail(error.what());
-    } catch (const InputError& error) {
-      in.fail(std::string("mesh ") + error.what());  // the mesh file's own line, and this element's
-    }
-    if (solidMeshes_[name]->cells.empty()) in.fail("the mesh has no cells");
-  }
-}
-
-int SceneCompiler::solidPositionDofs(const XMLElement& element, int& internal) const {
-  const Mesh& mesh = *solidMeshes_.at(element.Attribute("name"));
-  if (element.Attribute("viscosity"))
-    for (const Cell& cell : mesh.cells) internal += 6 * quadraturePointsOf(cell);
-  return 3 * static_cast<int>(mesh.nodes.size());
-}
-
-int SceneCompiler::solidJointNodes(const XMLElement& element) const {
-  const char* solid = element.Attribute("solid");
-  const char* surface = element.Attribute("surface");
-  const auto mesh = solid ? solidMeshes_.find(solid) : solidMeshes_.end();
-  if (mesh == solidMeshes_.end() || !surface) return 0;  // reported when the element is read
+DofDemand declareSolid(ElementReader& in, SceneBuild& build) {
+  const MeshSource source = readMeshSource(in);
+  std::shared_ptr<const Mesh> mesh;
   try {
-    return static_cast<int>(mesh->second->nodesOf(surface).size());
-  } catch (const std::out_of_range&) {
-    return 0;
+    mesh = std::make_shared<const Mesh>(buildMesh(source, in.element().where.file));
+  } catch (const std::invalid_argument& error) {
+    in.fail(error.what());
+  } catch (const InputError& error) {
+    in.fail(std::string("mesh ") + error.what());  // the mesh file's own line, and this element's
   }
+  if (mesh->cells.empty()) in.fail("the mesh has no cells");
+  build.meshOfSolid[&in.element()] = mesh;
+  if (const std::string* name = in.element().find("name")) build.meshByName.emplace(*name, mesh);
+  DofDemand demand{3 * static_cast<int>(mesh->nodes.size()), 0, 0, 0};
+  if (in.has("viscosity"))
+    for (const Cell& cell : mesh->cells) demand.internal += 6 * quadraturePointsOf(cell);
+  return demand;
 }
 
-void SceneCompiler::addSolid(ElementReader& in) {
-  const std::string name = declareName(in);
+void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
+  const std::string name = build.declareName(in);
   readMeshSource(in);
-  const std::shared_ptr<const Mesh> mesh = solidMeshes_.at(name);
+  const std::shared_ptr<const Mesh> mesh = build.meshOfSolid.at(&in.element());
   std::shared_ptr<const HyperelasticMaterial> material;
   const std::string law = in.text("material", "neo_hooke");
   std::optional<ViscousBranch> branch;
@@ -143,9 +129,8 @@ void SceneCompiler::addSolid(ElementReader& in) {
   }
 
   // initial state: reference positions, a rigid velocity field plus an optional twist
-  const int first = layout_.dof(Block::Position, positionCount_);
-  const int shift = layout_.offset(Block::Velocity) - layout_.offset(Block::Position);
-  positionCount_ += 3 * static_cast<int>(mesh->nodes.size());
+  const int shift = build.velocityShift();
+  const int first = dofs.take(Block::Position, 3 * static_cast<int>(mesh->nodes.size()));
   Vec3 centroid = Vec3::Zero();
   for (const Vec3& x : mesh->nodes) centroid += x / static_cast<double>(mesh->nodes.size());
   const Vec3 velocity = in.vector("velocity", Vec3::Zero()), angular = in.vector("angular_velocity", Vec3::Zero());
@@ -156,22 +141,21 @@ void SceneCompiler::addSolid(ElementReader& in) {
   for (std::size_t n = 0; n < mesh->nodes.size(); ++n) {
     const Vec3& X = mesh->nodes[n];
     const int dof = first + 3 * static_cast<int>(n);
-    state_.segment<3>(dof) = X;
-    state_.segment<3>(dof + shift) =
+    build.state.segment<3>(dof) = X;
+    build.state.segment<3>(dof + shift) =
         velocity + angular.cross(X - center) + twist[0] * std::sin(M_PI * X.y() / twist[1]) * Vec3(X.z(), 0.0, -X.x());
     low = low.cwiseMin(X);
     high = high.cwiseMax(X);
   }
-  keepPositionScale((high - low).norm());
+  build.keepPositionScale((high - low).norm());
 
   // one element and one inertia per cell; a node's kinematic rows belong to its first cell
-  int nextInternal = branch ? layout_.dof(Block::Internal, internalCount_) : -1;
   std::vector<bool> owned(mesh->nodes.size(), false);
-  SolidOutput output{name, mesh, first, shift, {}};
+  SolidPlacement placement{name, mesh, first, shift, {}};
   for (std::size_t c = 0; c < mesh->cells.size(); ++c) {
     const Cell& cell = mesh->cells[c];
-    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, nextInternal, {}, material, branch};
-    SolidInertiaSpec inertia{element.name + ".inertia", {}, shift, {}, {}, density, gravity_};
+    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, -1, {}, material, branch};
+    SolidInertiaSpec inertia{element.name + ".inertia", {}, shift, {}, {}, density, build.spec.gravity};
     for (int a = 0; a < nodeCount(cell.type); ++a) {
       element.positionDofs.push_back(first + 3 * cell.nodes[a]);
       inertia.ownsNode.push_back(!owned[cell.nodes[a]]);
@@ -186,53 +170,34 @@ void SceneCompiler::addSolid(ElementReader& in) {
     }
     if (branch) {
       const int count = 6 * static_cast<int>(element.points.size());
-      scale_.segment(nextInternal, count).setOnes();
-      nextInternal += count;
-      internalCount_ += count;
+      element.firstInternalDof = dofs.take(Block::Internal, count);
+      build.scale.segment(element.firstInternalDof, count).setConstant(kViscousStrainScale);
     }
     auto solidElement = std::make_unique<SolidElement>(std::move(element));
-    output.cells.push_back(solidElement.get());
-    components_.push_back(std::move(solidElement));
-    components_.push_back(std::make_unique<SolidInertia>(inertia));
+    placement.cells.push_back(solidElement.get());
+    build.addComponent(std::move(solidElement));
+    build.addComponent(std::make_unique<SolidInertia>(inertia));
   }
-  solids_.push_back(std::move(output));
+  build.solids.push_back(std::move(placement));
 }
 
-const SolidOutput& SceneCompiler::solidOf(ElementReader& in) {
-  const std::string name = in.text("solid");
-  for (const SolidOutput& solid : solids_)
-    if (solid.name == name) return solid;
-  in.fail("attribute 'solid': no solid named '" + name + "' declared above this element");
-}
-
-std::vector<int> SceneCompiler::solidNodes(ElementReader& in, const SolidOutput& solid) {
-  const std::string set = in.text("surface");
-  try {
-    return solid.mesh->nodesOf(set);
-  } catch (const std::out_of_range&) {
-    std::string known;
-    for (const auto& [name, faces] : solid.mesh->surfaces) known += " " + name;
-    for (const auto& [name, nodes] : solid.mesh->nodeSets) known += " " + name;
-    in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface or node set '" + set +
-            "' (it has:" + known + ")");
-  }
-}
-
-void SceneCompiler::addNodalForces(const std::string& name, const SolidOutput& solid,
-                                   const std::map<int, Vec3>& forces, const TimeFunction& profile) {
+// Add one nodal force per entry of `forces` (node -> force), scaled by `profile`.
+void addNodalForces(SceneBuild& build, const std::string& name, const SolidPlacement& solid,
+                    const std::map<int, Vec3>& forces, const TimeFunction& profile) {
   for (const auto& [node, force] : forces) {
     const int dof = solid.firstPositionDof + 3 * node;
-    components_.push_back(
-        std::make_unique<ExternalForce>(name + ".node" + std::to_string(node), dof, dof + solid.velocityShift, force, profile));
+    build.addComponent(std::make_unique<ExternalForce>(name + ".node" + std::to_string(node), dof,
+                                                       dof + solid.velocityShift, force, profile));
   }
 }
 
-void SceneCompiler::addTraction(ElementReader& in) {
-  const std::string name = declareName(in);
-  const SolidOutput& solid = solidOf(in);
+void buildTraction(ElementReader& in, SceneBuild& build, DofRange&) {
+  const std::string name = build.declareName(in);
+  const SolidPlacement& solid = build.solidOf(in);
   const std::string surface = in.text("surface");
   const auto faces = solid.mesh->surfaces.find(surface);
-  if (faces == solid.mesh->surfaces.end()) in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface '" + surface + "'");
+  if (faces == solid.mesh->surfaces.end())
+    in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface '" + surface + "'");
   if (in.has("traction") == in.has("total_force"))
     in.fail("give exactly one of 'traction' (force per reference area) and 'total_force'");
 
@@ -246,15 +211,16 @@ void SceneCompiler::addTraction(ElementReader& in) {
       area += share[a];
     }
   }
-  const Vec3 traction = in.has("traction") ? in.vector("traction", Vec3::Zero()) : in.vector("total_force", Vec3::Zero()) / area;
+  const Vec3 traction =
+      in.has("traction") ? in.vector("traction", Vec3::Zero()) : in.vector("total_force", Vec3::Zero()) / area;
   std::map<int, Vec3> forces;
   for (const auto& [node, share] : nodeArea) forces[node] = share * traction;
-  addNodalForces(name, solid, forces, readProfile(in));
+  addNodalForces(build, name, solid, forces, readProfile(in));
 }
 
-void SceneCompiler::addBodyForce(ElementReader& in) {
-  const std::string name = declareName(in);
-  const SolidOutput& solid = solidOf(in);
+void buildBodyForce(ElementReader& in, SceneBuild& build, DofRange&) {
+  const std::string name = build.declareName(in);
+  const SolidPlacement& solid = build.solidOf(in);
   const Vec3 density = in.vector("force_density", Vec3::Zero());
   // consistent nodal loads: force per reference volume times int N_a dV
   std::map<int, Vec3> forces;
@@ -264,12 +230,14 @@ void SceneCompiler::addBodyForce(ElementReader& in) {
         auto [it, inserted] = forces.emplace(cell.nodes[a], Vec3::Zero());
         it->second += p.weight * p.values[a] * density;
       }
-  addNodalForces(name, solid, forces, readProfile(in));
+  addNodalForces(build, name, solid, forces, readProfile(in));
 }
 
-void SceneCompiler::addPrescribedMotion(ElementReader& in, MotionKind kind) {
-  const SolidOutput& solid = solidOf(in);
-  const std::vector<int> nodes = solidNodes(in, solid);
+enum class MotionKind { Clamp, Velocity, Displacement };
+
+void buildPrescribedMotion(ElementReader& in, SceneBuild& build, MotionKind kind) {
+  const SolidPlacement& solid = build.solidOf(in);
+  const std::vector<int> nodes = build.solidNodes(in, solid);
   const std::string directions = in.text("directions", "xyz");
   if (directions.empty() || directions.find_first_not_of("xyz") != std::string::npos)
     in.fail("directions must be letters from 'xyz', got '" + directions + "'");
@@ -278,40 +246,70 @@ void SceneCompiler::addPrescribedMotion(ElementReader& in, MotionKind kind) {
   const TimeFunction profile = clamp ? TimeFunction::constant(0.0) : readProfile(in);
   // the initial velocity that the motion starts with
   const Vec3 startVelocity = amplitude * (displacement ? profile.slope(0.0) : profile(0.0));
+  std::vector<PrescribedMotion>& motions = build.prescribedMotions;
   for (int node : nodes)
     for (char direction : directions) {
       const int k = direction - 'x';
       const int dof = solid.firstPositionDof + 3 * node + k + solid.velocityShift;
       // supports meeting at an edge may prescribe a dof twice: the same clamp is fine
-      const auto same = std::find_if(prescribedMotions_.begin(), prescribedMotions_.end(),
-                                     [&](const PrescribedMotion& p) { return p.dof == dof; });
-      if (same != prescribedMotions_.end()) {
+      const auto same =
+          std::find_if(motions.begin(), motions.end(), [&](const PrescribedMotion& p) { return p.dof == dof; });
+      if (same != motions.end()) {
         if (clamp && same->amplitude == 0.0) continue;
         in.fail("node " + std::to_string(node) + " of '" + solid.name + "' already has a prescribed motion in " +
                 direction);
       }
-      prescribedMotions_.push_back({dof, amplitude[k], profile, displacement});
-      state_[dof] = startVelocity[k];
+      motions.push_back({dof, amplitude[k], profile, displacement});
+      build.state[dof] = startVelocity[k];
     }
 }
 
-void SceneCompiler::addSolidJoint(ElementReader& in) {
-  const std::string name = declareName(in);
-  const SolidOutput& solid = solidOf(in);
-  const std::vector<int> nodes = solidNodes(in, solid);
-  const std::string target = in.text("to");
-  const auto to = attachments_.find(target);
-  if (to == attachments_.end()) in.fail("attribute 'to': no body, mass or anchor named '" + target + "' declared above");
-  const ConstraintSettings settings = constraintSettings(in);
+// A spherical joint (3 constraints, 2 multipliers each) per node of the surface.
+DofDemand declareSolidJoint(ElementReader& in, SceneBuild& build) {
+  const std::string* solid = in.element().find("solid");
+  const std::string* surface = in.element().find("surface");
+  const auto mesh = solid ? build.meshByName.find(*solid) : build.meshByName.end();
+  if (mesh == build.meshByName.end() || !surface || !build.takesMultipliers(in)) return {};
+  try {
+    return {0, 0, 0, 2 * 3 * static_cast<int>(mesh->second->nodesOf(*surface).size())};
+  } catch (const std::out_of_range&) {
+    return {};  // reported when the element is built
+  }
+}
+
+void buildSolidJoint(ElementReader& in, SceneBuild& build, DofRange& dofs) {
+  const std::string name = build.declareName(in);
+  const SolidPlacement& solid = build.solidOf(in);
+  const std::vector<int> nodes = build.solidNodes(in, solid);
+  const Attachment to = build.attachment(in, "to");
+  const ConstraintSettings settings = build.constraintSettings(in);
   // each node is held at its material point of the target (a spherical joint per node)
   for (int node : nodes) {
     const int dof = solid.firstPositionDof + 3 * node;
-    const Attachment point{Attachment::Kind::Point, dof, state_.segment<3>(dof), Mat3::Identity()};
-    const JointBuilder builder(point, to->second);
+    const Attachment point{Attachment::Kind::Point, dof, build.state.segment<3>(dof), Mat3::Identity()};
+    const JointBuilder builder(point, to);
     JointGeometry geometry;
     geometry.anchor = point.position;
-    addConstraint(name + ".node" + std::to_string(node), builder, builder.joint(JointType::Spherical, geometry), settings);
+    build.addConstraint(name + ".node" + std::to_string(node), builder, builder.joint(JointType::Spherical, geometry),
+                        settings, dofs);
   }
+}
+
+}  // namespace
+
+const std::vector<ElementKind>& solidElementKinds() {
+  static const std::vector<ElementKind> kinds = {
+      {"solid", declareSolid, buildSolid},
+      {"traction", nullptr, buildTraction},
+      {"body_force", nullptr, buildBodyForce},
+      {"clamp", nullptr, [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Clamp); }},
+      {"prescribed_velocity", nullptr,
+       [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Velocity); }},
+      {"prescribed_displacement", nullptr,
+       [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Displacement); }},
+      {"solid_joint", declareSolidJoint, buildSolidJoint},
+  };
+  return kinds;
 }
 
 }  // namespace mpx

@@ -1,0 +1,204 @@
+#include "models/scene/scene_build.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace mpx {
+
+DofRange::DofRange(const Layout& layout, const DofDemand& first, const DofDemand& declared)
+    : layout_(layout), first_(first), declared_(declared) {}
+
+int& DofRange::of(DofDemand& demand, Block block) {
+  switch (block) {
+    case Block::Position: return demand.positions;
+    case Block::Thermal: return demand.thermal;
+    case Block::Internal: return demand.internal;
+    case Block::Multiplier: return demand.multipliers;
+    case Block::Velocity: break;
+  }
+  throw std::logic_error("velocity dofs come with their positions");
+}
+
+int DofRange::of(const DofDemand& demand, Block block) { return of(const_cast<DofDemand&>(demand), block); }
+
+int DofRange::take(Block block, int count) {
+  int& taken = of(taken_, block);
+  if (taken + count > of(declared_, block))
+    throw std::logic_error("an element builds more " + std::string(blockName(block)) + " dofs (" +
+                           std::to_string(taken + count) + ") than it declared (" +
+                           std::to_string(of(declared_, block)) + ")");
+  const int dof = layout_.dof(block, of(first_, block) + taken);
+  taken += count;
+  return dof;
+}
+
+void DofRange::checkAllTaken(const std::string& where) const {
+  for (Block block : {Block::Position, Block::Thermal, Block::Internal, Block::Multiplier})
+    if (of(taken_, block) != of(declared_, block))
+      throw std::logic_error(where + ": the element declared " + std::to_string(of(declared_, block)) + " " +
+                             std::string(blockName(block)) + " dofs but built " + std::to_string(of(taken_, block)));
+}
+
+void SceneBuild::allocate(const Layout& assigned) {
+  layout = assigned;
+  state = Eigen::VectorXd::Zero(layout.total());
+  scale = Eigen::VectorXd::Zero(layout.total());
+}
+
+std::string SceneBuild::declareName(ElementReader& in) {
+  const std::string name = in.text("name");
+  if (name.empty()) in.fail("name must not be empty");
+  const auto [first, inserted] = names_.emplace(name, in.element().where);
+  if (!inserted) {
+    const SourceLocation& there = first->second;
+    const bool sameFile = there.line > 0 && there.file == in.element().where.file;
+    in.fail("name '" + name + "' is already used " +
+            (sameFile ? "on line " + std::to_string(there.line) : "at " + there.describe()));
+  }
+  return name;
+}
+
+Endpoint SceneBuild::endpoint(ElementReader& in, const char* attribute) const {
+  const std::string name = in.text(attribute);
+  const auto it = points.find(name);
+  if (it == points.end())
+    in.fail(std::string("attribute '") + attribute + "': no mass or anchor named '" + name +
+            "' declared above this element");
+  return it->second;
+}
+
+Vec3 SceneBuild::positionOf(const Endpoint& end) const {
+  return end.isMass() ? Vec3(state.segment<3>(end.positionDof)) : end.anchor;
+}
+
+std::pair<Endpoint, Endpoint> SceneBuild::endpoints(ElementReader& in) {
+  const Endpoint a = endpoint(in, "a"), b = endpoint(in, "b");
+  const double length = (positionOf(b) - positionOf(a)).norm();
+  if (!(length > 0.0)) in.fail("end points 'a' and 'b' coincide: the element has no direction");
+  keepPositionScale(length);
+  return {a, b};
+}
+
+const Attachment& SceneBuild::attachment(ElementReader& in, const char* attribute) const {
+  const std::string target = in.text(attribute);
+  const auto it = attachments.find(target);
+  if (it == attachments.end())
+    in.fail(std::string("attribute '") + attribute + "': no body, mass or anchor named '" + target +
+            "' declared above this element");
+  return it->second;
+}
+
+ThermalNodeRef SceneBuild::thermalNode(ElementReader& in, const char* attribute) const {
+  const std::string name = in.text(attribute);
+  const auto it = thermalNodes.find(name);
+  if (it == thermalNodes.end())
+    in.fail(std::string("attribute '") + attribute + "': no thermal node named '" + name +
+            "' declared above (thermo_spring, thermo_maxwell, reservoir or fixed_temperature)");
+  return it->second;
+}
+
+int SceneBuild::addThermalNode(const std::string& name, int dof, double dofScale) {
+  const int node = static_cast<int>(thermalNodeNames.size());
+  thermalNodeNames.push_back(name);
+  thermalNodes[name] = ThermalNodeRef{node, dof, {}};
+  if (dof >= 0) scale[dof] = dofScale;
+  return node;
+}
+
+void SceneBuild::addComponent(std::unique_ptr<Component> component) {
+  if (const auto node = thermalNodes.find(component->name()); node != thermalNodes.end() && node->second.thermalDof >= 0)
+    node->second.ownerDofs = component->dofs();
+  components.push_back(std::move(component));
+}
+
+ConstraintSettings SceneBuild::constraintSettings(ElementReader& in) const {
+  ConstraintSettings settings = spec.constraints;
+  const std::string enforcement =
+      in.text("enforcement", settings.enforcement == Enforcement::Penalty ? "penalty" : "augmented_lagrangian");
+  if (enforcement != "penalty" && enforcement != "augmented_lagrangian")
+    in.fail("enforcement must be 'penalty' or 'augmented_lagrangian', got '" + enforcement + "'");
+  settings.enforcement = enforcement == "penalty" ? Enforcement::Penalty : Enforcement::AugmentedLagrangian;
+  settings.stiffness = in.positive("stiffness", settings.stiffness);
+  return settings;
+}
+
+bool SceneBuild::takesMultipliers(const ElementReader& in) const {
+  const std::string* enforcement = in.element().find("enforcement");
+  return enforcement ? *enforcement == "augmented_lagrangian"
+                     : spec.constraints.enforcement == Enforcement::AugmentedLagrangian;
+}
+
+void SceneBuild::addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
+                               const ConstraintSettings& settings, DofRange& dofs) {
+  ConstraintSpec constraint;
+  constraint.name = name;
+  constraint.positionDofs = builder.positionDofs();
+  constraint.velocityShift = velocityShift();
+  constraint.enforcement = settings.enforcement;
+  constraint.stiffness = settings.stiffness;
+  // two multipliers per constraint: lambda, and mu of the rate form (GGL)
+  if (settings.enforcement == Enforcement::AugmentedLagrangian) {
+    const int count = 2 * static_cast<int>(forms.size());
+    constraint.firstMultiplierDof = dofs.take(Block::Multiplier, count);
+    scale.segment(constraint.firstMultiplierDof, count).setOnes();
+  }
+  constraint.forms = std::move(forms);
+  addComponent(std::make_unique<QuadraticConstraint>(std::move(constraint)));
+}
+
+const SolidPlacement& SceneBuild::solidOf(ElementReader& in) const {
+  const std::string name = in.text("solid");
+  for (const SolidPlacement& solid : solids)
+    if (solid.name == name) return solid;
+  in.fail("attribute 'solid': no solid named '" + name + "' declared above this element");
+}
+
+std::vector<int> SceneBuild::solidNodes(ElementReader& in, const SolidPlacement& solid) const {
+  const std::string set = in.text("surface");
+  try {
+    return solid.mesh->nodesOf(set);
+  } catch (const std::out_of_range&) {
+    std::string known;
+    for (const auto& [name, faces] : solid.mesh->surfaces) known += " " + name;
+    for (const auto& [name, nodes] : solid.mesh->nodeSets) known += " " + name;
+    in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface or node set '" + set +
+            "' (it has:" + known + ")");
+  }
+}
+
+const ElementKind* findElementKind(const std::string& tag) {
+  for (const auto* family : {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+    for (const ElementKind& kind : *family)
+      if (tag == kind.tag) return &kind;
+  return nullptr;
+}
+
+std::string elementTags() {
+  std::string tags;
+  for (const auto* family : {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+    for (const ElementKind& kind : *family) tags += (tags.empty() ? "" : ", ") + std::string(kind.tag);
+  return tags;
+}
+
+TimeFunction readProfile(ElementReader& in) {
+  const std::string profile = in.text("profile", "constant");
+  if (profile == "constant") return TimeFunction::constant();
+  if (profile == "ramp") {
+    const double start = in.nonNegative("start", 0.0), end = in.positive("end");
+    if (!(end > start)) in.fail("ramp needs end > start");
+    return TimeFunction::ramp(start, end);
+  }
+  if (profile == "hat") return TimeFunction::hat(in.positive("period"));
+  if (profile == "sine_pulse") return TimeFunction::sinePulse(in.positive("duration"));
+  if (profile == "table") {
+    std::vector<double> times = in.numbers("times"), values = in.numbers("values");
+    if (times.empty() || times.size() != values.size()) in.fail("'times' and 'values' need the same, non-zero count");
+    if (!std::is_sorted(times.begin(), times.end(), std::less_equal<>()) ||
+        std::adjacent_find(times.begin(), times.end()) != times.end())
+      in.fail("'times' must be strictly increasing");
+    return TimeFunction::table(std::move(times), std::move(values));
+  }
+  in.fail("profile must be constant, ramp, hat, sine_pulse or table, got '" + profile + "'");
+}
+
+}  // namespace mpx
