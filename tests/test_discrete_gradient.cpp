@@ -1,4 +1,4 @@
-// Discrete gradients (eem-primer.md section 2) on smooth functions and on the element laws, and
+// Discrete gradients (docs/theory.md section 2) on smooth functions and on the element laws, and
 // the laws' own jets and thermodynamics, which the discrete gradients and the tangents rely on.
 #include "engine/core/discrete_gradient.hpp"
 #include "models/lumped/element_laws.hpp"

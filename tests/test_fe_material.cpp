@@ -19,7 +19,7 @@
 namespace mpx {
 namespace {
 
-// Lame constants of the thesis' elastic solid (E = 2.26115e3, nu = 0.395469).
+// Lame constants of the L-block's elastic solid (docs/theory.md section 11.3: E = 2.26115e3, nu = 0.395469).
 const LameParameters kLame = LameParameters::fromYoung(2.26115e3, 0.395469);
 
 enum class Law { SaintVenantKirchhoff, NeoHooke };

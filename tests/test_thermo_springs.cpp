@@ -1,6 +1,6 @@
-// Two thermo-spring system (thesis section 2.1) over 10^4 steps at a step where the implicit
-// midpoint rule visibly drifts: EEM keeps energy and angular momentum and never lets entropy
-// decrease, with either thermal variable.
+// Two thermo-spring system (docs/theory.md section 11.1, after [Conde Martín 2016] section 2.1)
+// over 10^4 steps at a step where the implicit midpoint rule visibly drifts: EEM keeps energy and
+// angular momentum and never lets entropy decrease, with either thermal variable.
 #include "support.hpp"
 
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // linearisation with respect to the end point (for Newton's consistent tangent).
 //
 // Both forms satisfy directionality exactly, DF(a, b) . (b - a) = F(b) - F(a), and are
-// symmetric in (a, b), hence consistent and second order (eem-primer.md section 2).
+// symmetric in (a, b), hence consistent and second order (docs/theory.md section 2).
 #include <Eigen/Dense>
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 #pragma once
 // Algorithmic stress S~ = 2 D_C W(C0, C1) of a hyperelastic law: Gonzalez discrete derivative of W with respect to C
-// in the Frobenius metric (eem-primer.md section 2),
+// in the Frobenius metric (docs/theory.md sections 2.3 and 8.2),
 //   S~ = S(Cm) + 2 [W(C1) - W(C0) - S(Cm):dC/2] dC / (dC:dC),  Cm = (C0 + C1)/2, dC = C1 - C0,
 // so that S~:(C1 - C0)/2 = W(C1) - W(C0) exactly (directionality); symmetric in (C0, C1), hence second order. Below
 // a relative increment |dC| <= 1e-8 max(|C0|, |C1|, 1) (Frobenius norms) it is S(Cm); W(C1) - W(C0)

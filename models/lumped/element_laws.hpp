@@ -40,13 +40,13 @@ struct ThermoElasticParameters {
   bool hasStretch = true;           // false: a pure heat capacity (reservoir)
 };
 
-// Thermo-spring of thesis eq 2.19 in the logarithmic strain L = log(lambda/lambda0), with an
-// optional Maxwell branch on the viscous strain gamma:
+// Thermo-spring of docs/theory.md section 4.6 (after [Conde Martín 2016] eq 2.19, docs/references.md) in the
+// logarithmic strain L = log(lambda/lambda0), with an optional Maxwell branch on the viscous strain gamma:
 //   Psi = C(theta)/2 L^2 - alpha (theta - theta_ref) L + c (theta - theta_ref - theta log(theta/theta_ref))
 //         + mu/2 (L - gamma)^2
 //   eta = -dPsi/dtheta,  e = Psi + theta eta = (C - theta C')/2 L^2 + alpha theta_ref L + c (theta - theta_ref)
 //         + mu/2 (L - gamma)^2.
-// In entropy form (needs C linear in theta, eq 2.27-2.28), theta(L, eta) is explicit:
+// In entropy form (needs C linear in theta, [Conde Martín 2016] eq 2.27-2.28), theta(L, eta) is explicit:
 //   theta = theta_ref exp((eta + C1/2 L^2 - alpha L)/c),  e = (C0 - C1 theta_ref)/2 L^2 + alpha theta_ref L
 //           + c (theta - theta_ref) + mu/2 (L - gamma)^2,  and the entropy argument is eta itself.
 // Without stretch (L = 0) this is a heat reservoir of capacity c.

@@ -3,7 +3,7 @@
 // stretch invariant c = |x_b - x_a|^2 between two end points, an own thermal node s and an
 // internal (viscous) variable gamma, each optional. Thermo-springs, Maxwell elements (with or
 // without a thermal node), elastic springs and heat reservoirs are all this component with a
-// different law; one recipe (eem-primer.md section 4) serves both thermal variables:
+// different law; one recipe (docs/theory.md section 4) serves both thermal variables:
 //   theta~ = D_s e / D_s eta,  f~ = D_c e - theta~ D_c eta,  g~ = -(D_gamma e - theta~ D_gamma eta)
 //   momentum:  f~ dc/dq(q_mid)          internal: nu (gamma' - gamma)/dt = g~
 //   thermal:   theta~ (eta' - eta)/dt = g~^2/nu + heat from links

@@ -1,7 +1,7 @@
 #pragma once
 // A constant diagonal mass matrix over consecutive blocks of three position dofs, with the
 // velocity dofs of the blocks at the same offsets. A point mass is one translational block; a
-// rigid body (centre of mass and three directors, eem-primer.md section 7) is a translational
+// rigid body (centre of mass and three directors, docs/theory.md section 7) is a translational
 // block of mass m and three director blocks of "masses" E_i = (J_j + J_k - J_i)/2. Rows:
 // kinematics x' = v, momentum m v' = m g (gravity on translational blocks; its potential
 // -m g.x is part of the energy).

@@ -1,6 +1,6 @@
 #pragma once
 // Quadratic constraint forms of joints and of director rigidity, built from affine maps
-// q -> R^3 of material points and material directions of the attached frames (eem-primer.md
+// q -> R^3 of material points and material directions of the attached frames (docs/theory.md
 // section 7): a body point is phi + X_i d_i, a body direction a_i d_i, both linear in q; a mass
 // point is x; the ground is constant. Points and directions are given in world coordinates at
 // the initial time and converted to body coordinates here.

@@ -1,7 +1,7 @@
 #pragma once
 // Holonomic constraints Phi_k(q) = 1/2 q.H_k q + g_k.q + c_k = 0 on a set of position dofs:
 // director rigidity, spherical, revolute, prismatic, ... joints and distances are all quadratic
-// in the director formulation (eem-primer.md sections 6-7). For a quadratic Phi the discrete
+// in the director formulation (docs/theory.md sections 6-7). For a quadratic Phi the discrete
 // gradient of V = lambda Phi + kappa/2 Phi^2 is exact:
 //   D V = (lambda + kappa (Phi(q) + Phi(q'))/2) grad Phi(q_mid),
 // so constraint forces do no spurious work. Penalty: lambda = 0. Augmented Lagrangian: one
