@@ -10,8 +10,9 @@
 
 namespace mpx::test {
 
-// Path of a file in scenes/.
-inline std::string scenePath(const std::string& file) { return std::string(METRIPLEX_SCENES_DIR) + "/" + file; }
+// Path of a test fixture in tests/data/ (copies of scenes, so that the demo scenes in scenes/
+// may change without changing what the tests assert).
+inline std::string scenePath(const std::string& file) { return std::string(METRIPLEX_TEST_DATA_DIR) + "/" + file; }
 
 // The whole text of a file ("" if it cannot be read).
 inline std::string readFile(const std::string& path) {
@@ -46,15 +47,53 @@ inline History run(const Model& model, Scheme scheme, double dt, double tEnd, Ne
     h.time.push_back(r.time);
     h.energy.push_back(r.measures->energy);
     h.entropy.push_back(r.measures->entropy);
-    h.dissipated.push_back(r.dissipated);
-    h.externalWork.push_back(r.externalWork);
-    h.boundaryHeat.push_back(r.boundaryHeat);
+    h.dissipated.push_back(r.crossed.dissipated);
+    h.externalWork.push_back(r.crossed.externalWork);
+    h.boundaryHeat.push_back(r.crossed.boundaryHeat);
     h.momentum.push_back(r.measures->momentum);
     h.angularMomentum.push_back(r.measures->angularMomentum);
     h.states.push_back(*r.state);
   });
   return h;
 }
+
+// Conservation checks computed from a history (not taken from the engine's own summary).
+
+// Largest |B_n - B_0| of the balance B = E + D - W - Q over the run (J).
+inline double maxBalanceDrift(const History& h) {
+  double drift = 0.0;
+  for (std::size_t n = 0; n < h.energy.size(); ++n)
+    drift = std::max(drift, std::abs(h.energy[n] + h.dissipated[n] - h.externalWork[n] - h.boundaryHeat[n] -
+                                     h.energy[0]));
+  return drift;
+}
+
+// What the balance is judged against: the largest |E|, D, |W| or |Q| of the run.
+inline double largestEnergy(const History& h) {
+  double scale = 0.0;
+  for (std::size_t n = 0; n < h.energy.size(); ++n)
+    scale = std::max({scale, std::abs(h.energy[n]), std::abs(h.dissipated[n]), std::abs(h.externalWork[n]),
+                      std::abs(h.boundaryHeat[n])});
+  return scale;
+}
+
+// The balance drift relative to the initial energy (for runs that start with energy).
+inline double relativeBalanceDrift(const History& h) { return maxBalanceDrift(h) / std::abs(h.energy.front()); }
+
+// Entropy may fall from one step to the next by at most this, relative to |S| (round-off of a
+// sum of element entropies).
+inline constexpr double kEntropyRoundOff = 1e-14;
+
+// The first step whose entropy falls below its predecessor's by more than kEntropyRoundOff,
+// or -1 when it never does.
+inline int firstEntropyDecrease(const History& h) {
+  for (std::size_t n = 1; n < h.entropy.size(); ++n)
+    if (h.entropy[n] - h.entropy[n - 1] < -kEntropyRoundOff * std::abs(h.entropy[n])) return static_cast<int>(n);
+  return -1;
+}
+
+// Newton gave up, or the balance is off by more than the engine's blow-up threshold.
+inline bool blewUp(const History& h) { return h.summary.failed || relativeBalanceDrift(h) > kBlowUpEnergyError; }
 
 // A compiled scene with the run that integrated it (the history refers to the model).
 struct SceneRun {

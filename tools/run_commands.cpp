@@ -76,7 +76,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.relativeTolerance = request.relativeTolerance;
   parameters.absoluteTolerance = request.absoluteTolerance;
   parameters.maxOrder = request.maxOrder;
-  if (method->ida) parameters.dt = request.outputStep.value_or(parameters.dt);
+  if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   std::filesystem::path out = request.out.empty()
                                   ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
                                   : std::filesystem::path(request.out);
@@ -116,8 +116,10 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
                "{} nonlinear iterations, {} error-test failures\n",
                s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
                s.ida->errorTestFailures);
-  else
+  else {
     fmt::print("  cut-backs                {}\n", s.cutbacks);
+    fmt::print("  linear system            {}\n", s.linearSystem);
+  }
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
   fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
              s.maxEnergyBalanceError);

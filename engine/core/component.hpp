@@ -50,10 +50,19 @@ struct RateArgs {
 // Power crossing the system boundary or leaving the mechanical energy (W): viscous power
 // without a thermal node, power of time-dependent external loads, heat through prescribed
 // temperatures into the system.
+// The same triple, integrated over a step or a run, is the energy that crossed (J).
 struct Flows {
   double dissipated = 0.0;
   double externalWork = 0.0;
   double boundaryHeat = 0.0;
+
+  Flows& operator+=(const Flows& other) {
+    dissipated += other.dissipated;
+    externalWork += other.externalWork;
+    boundaryHeat += other.boundaryHeat;
+    return *this;
+  }
+  Flows operator*(double factor) const { return {factor * dissipated, factor * externalWork, factor * boundaryHeat}; }
 };
 
 // Local residual r (n) and tangent K (n x n, column-major), zeroed before each evaluation.

@@ -46,9 +46,7 @@ class Assembler {
       Flows componentFlows;
       evaluate(*components[c], ws, local, componentFlows);
       scatter(c, components[c]->dofs(), local, weight);
-      flows_.dissipated += weight * componentFlows.dissipated;
-      flows_.externalWork += weight * componentFlows.externalWork;
-      flows_.boundaryHeat += weight * componentFlows.boundaryHeat;
+      flows_ += componentFlows * weight;
     }
   }
 

@@ -42,10 +42,17 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
         kinematicRows_[row].push_back({column, entry});
       else if (column - nv == row)
         pivotEntry_[row] = entry;
-      else
-        return false;  // a kinematic row couples to another dof's velocity
+      else {
+        wholeSystemReason_ = "the kinematic row of position dof " + std::to_string(row) + " couples to velocity dof " +
+                             std::to_string(column) + " (a component declares that it writes position rows)";
+        return false;
+      }
     }
-  if (std::count(pivotEntry_.begin(), pivotEntry_.end(), -1) > 0) return false;
+  if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
+    wholeSystemReason_ = "position dof " + std::to_string(missing - pivotEntry_.begin()) +
+                         " has no kinematic row (no inertia owns it)";
+    return false;
+  }
 
   // condensed pattern: kept entries of K, plus the fill of the products K(j, v_i) K(q_i, c)
   std::vector<Eigen::Triplet<double>> entries;
@@ -136,6 +143,12 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
     for (const RowEntry& kinematic : kinematicRows_[i]) sum += k[kinematic.entry] * increment[kinematic.column];
     increment[nv + i] = -sum / k[pivotEntry_[i]];
   }
+}
+
+std::string CondensedSolver::describe() const {
+  const std::string size = std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) + " unknowns factorised";
+  if (velocities_ > 0) return size + " (velocities" + (internal_.active() ? " and internal variables" : "") + " eliminated)";
+  return wholeSystemReason_.empty() ? size : size + "; solved whole because " + wholeSystemReason_;
 }
 
 }  // namespace mpx

@@ -17,6 +17,7 @@
 #include <Eigen/Sparse>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace mpx {
@@ -33,6 +34,10 @@ class CondensedSolver {
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Unknowns of the system actually factorised.
   int condensedSize() const { return static_cast<int>(factorised().rows()); }
+  // Why the velocities could not be eliminated ("" when they are, or when there are none).
+  const std::string& wholeSystemReason() const { return wholeSystemReason_; }
+  // One line for run summaries: what is factorised, and why it is not condensed if it is not.
+  std::string describe() const;
 
  private:
   // One term K(j, v_i) K(q_i, c) / d_i of the condensed entry (j, c).
@@ -57,6 +62,7 @@ class CondensedSolver {
   }
 
   int velocities_ = 0;  // 0: solved whole
+  std::string wholeSystemReason_;
   const Eigen::SparseMatrix<double>* pattern_;
   const Eigen::SparseMatrix<double>* tangent_ = nullptr;
   Eigen::SparseMatrix<double> reduced_;

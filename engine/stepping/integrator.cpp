@@ -71,10 +71,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance &&
         residualNorm <= settings_.residualTolerance) {
-      const Flows& flows = system.flows();
-      outcome.energy.dissipated += dt * flows.dissipated;
-      outcome.energy.externalWork += dt * flows.externalWork;
-      outcome.energy.boundaryHeat += dt * flows.boundaryHeat;
+      outcome.energy += system.flows() * dt;
       return true;
     }
     if (iteration == settings_.maxIterations)

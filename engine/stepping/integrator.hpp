@@ -23,18 +23,11 @@ struct NewtonSettings {
   int maxCutbacks = 6;  // each halves the step
 };
 
-// Energy crossing the boundary during one step (J); see Flows.
-struct StepEnergy {
-  double dissipated = 0.0;
-  double externalWork = 0.0;
-  double boundaryHeat = 0.0;
-};
-
 struct StepOutcome {
   bool converged = false;
   int iterations = 0;  // Newton iterations, all sub-steps
   int cutbacks = 0;    // halvings needed
-  StepEnergy energy;
+  Flows energy;  // crossed during the step (J)
   // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
   // recovered Newton failure does not allocate
   char failure[200] = "";
@@ -51,6 +44,7 @@ class Integrator {
   // Residual and tangent of the step zOld -> zNew (exposed for tangent tests).
   Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
   Scheme scheme() const { return scheme_; }
+  const CondensedSolver& linearSolver() const { return solver_; }
 
  private:
   // Midpoint or trapezoidal residual of the step from the components' rate form.

@@ -5,17 +5,17 @@
 namespace mpx {
 
 std::optional<Method> methodByName(const std::string& name) {
-  if (name == "eem") return Method{name, false, Scheme::Eem, std::nullopt};
-  if (name == "eem-entropy") return Method{name, false, Scheme::Eem, ThermalVariable::Entropy};
-  if (name == "eem-temperature") return Method{name, false, Scheme::Eem, ThermalVariable::Temperature};
-  if (name == "midpoint") return Method{name, false, Scheme::Midpoint, std::nullopt};
-  if (name == "trapezoidal") return Method{name, false, Scheme::Trapezoidal, std::nullopt};
-  if (name == "ida") return Method{name, true, Scheme::Eem, std::nullopt};
+  if (name == "eem") return Method{name, Scheme::Eem, std::nullopt};
+  if (name == "eem-entropy") return Method{name, Scheme::Eem, ThermalVariable::Entropy};
+  if (name == "eem-temperature") return Method{name, Scheme::Eem, ThermalVariable::Temperature};
+  if (name == "midpoint") return Method{name, Scheme::Midpoint, std::nullopt};
+  if (name == "trapezoidal") return Method{name, Scheme::Trapezoidal, std::nullopt};
+  if (name == "ida") return Method{name, std::nullopt, std::nullopt};
   return std::nullopt;
 }
 
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene) {
-  if (!method.ida) return;
+  if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.displacement)
       throw InputError(scene + ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
@@ -24,9 +24,9 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
 
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& p, const StepSink& sink,
                      const ProgressSink& progress) {
-  if (method.ida)
+  if (method.isIda())
     return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.dt, p.tEnd}, sink, progress);
-  return simulate(model, {method.scheme, p.dt, p.tEnd, p.newton}, sink, progress);
+  return simulate(model, {*method.scheme, p.dt, p.tEnd, p.newton}, sink, progress);
 }
 
 }  // namespace mpx

@@ -12,9 +12,9 @@ namespace mpx {
 
 struct Method {
   std::string name;
-  bool ida = false;             // SUNDIALS IDA instead of a one-step scheme
-  Scheme scheme = Scheme::Eem;  // the one-step scheme otherwise
+  std::optional<Scheme> scheme;  // the one-step scheme; none for SUNDIALS IDA
   std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
+  bool isIda() const { return !scheme; }
 };
 
 // The names methodByName accepts, for messages.

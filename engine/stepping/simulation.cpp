@@ -21,13 +21,11 @@ RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink,
   sink_(record_);
 }
 
-void RunReporter::report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks) {
+void RunReporter::report(int step, double time, const Flows& crossed, int newtonIterations, int cutbacks) {
   model_.measure(state_, measures_);
   record_.step = step;
   record_.time = time;
-  record_.dissipated = crossed.dissipated;
-  record_.externalWork = crossed.externalWork;
-  record_.boundaryHeat = crossed.boundaryHeat;
+  record_.crossed = crossed;
   record_.newtonIterations = newtonIterations;
   record_.cutbacks = cutbacks;
   sink_(record_);
@@ -51,11 +49,12 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
                     const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
+  summary.linearSystem = integrator.linearSolver().describe();
   // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
   const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
   RunReporter reporter(model, summary, sink, progress, steps);
   Eigen::VectorXd next(reporter.state().size());
-  StepEnergy crossed;
+  Flows crossed;
   for (int n = 1; n <= steps; ++n) {
     const double t = reporter.last().time;
     const double dt = std::min(options.dt, options.tEnd - t);
@@ -70,9 +69,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
       break;
     }
     reporter.state().swap(next);
-    crossed.dissipated += outcome.energy.dissipated;
-    crossed.externalWork += outcome.energy.externalWork;
-    crossed.boundaryHeat += outcome.energy.boundaryHeat;
+    crossed += outcome.energy;
     reporter.report(n, n == steps ? options.tEnd : t + dt, crossed, outcome.iterations, outcome.cutbacks);
   }
   reporter.finish();

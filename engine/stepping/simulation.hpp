@@ -25,9 +25,7 @@ struct StepRecord {
   double time = 0.0;
   const Eigen::VectorXd* state = nullptr;
   const Measures* measures = nullptr;
-  double dissipated = 0.0;
-  double externalWork = 0.0;
-  double boundaryHeat = 0.0;
+  Flows crossed;
   int newtonIterations = 0;
   int cutbacks = 0;
 };
@@ -57,6 +55,10 @@ class EnergyBalance {
   double initial_, scale_, largestError_ = 0.0;
 };
 
+// A run whose largest relative energy balance error (EnergyBalance) exceeds this has blown up:
+// the one threshold the tests, bench and docs use.
+inline constexpr double kBlowUpEnergyError = 0.1;
+
 struct RunSummary {
   int steps = 0;
   long newtonIterations = 0;
@@ -68,6 +70,7 @@ struct RunSummary {
   double maxEnergyBalanceError = 0.0;
   double minEntropyIncrement = 0.0;  // min_n (S_n - S_{n-1})
   std::optional<IdaStatistics> ida;  // set for IDA runs
+  std::string linearSystem;          // what each Newton iteration factorises (one-step schemes)
   bool failed = false;
   int failedStep = 0;
   double failedTime = 0.0;
@@ -89,7 +92,7 @@ class RunReporter {
   Eigen::VectorXd& state() { return state_; }
   const StepRecord& last() const { return record_; }
   // Report state() as `step` at `time`; `crossed` holds the energies crossed since t = 0.
-  void report(int step, double time, const StepEnergy& crossed, int newtonIterations, int cutbacks);
+  void report(int step, double time, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();
 

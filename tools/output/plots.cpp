@@ -65,7 +65,7 @@ void renderPlots(const std::filesystem::path& dir, const std::string& sceneName,
     out.print("{}", plotCommand(wpFiles, wpLabels, "1:2", "linespoints lw 2 pt 7"));
     out.print("{}", header(dir / "energy_error.png", fmt::format("Energy balance error, {}", sceneName)));
     out.print("set logscale y\nset format y '10^{{%L}}'\nset format x '%g'\n");
-    out.print("set xlabel 'time [s]'\nset ylabel '|E + D - W - Q - E_0| / |E_0| [-]'\n");
+    out.print("set xlabel 'time [s]'\nset ylabel '|E + D - W - Q - E_0| / largest energy so far [-]'\n");
     out.print("{}", plotCommand(seriesFiles, seriesLabels, "1:2", "lines lw 2"));
     out.print("{}", header(dir / "entropy.png", fmt::format("Entropy, {}", sceneName)));
     out.print("set format y '%g'\nset xlabel 'time [s]'\nset ylabel 'S(t) - S(0) [J/K]'\n");

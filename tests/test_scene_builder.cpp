@@ -1,0 +1,118 @@
+// The scene front end: a scene built in code (SceneSpec) compiles to the same model as the
+// XML file that says the same, the declarations of every element kind and what its builder
+// takes agree (DofRange refuses more and reports less), every registered element is
+// documented, and the XML reader rejects what it would otherwise ignore.
+#include "support.hpp"
+
+#include "models/scene/xml_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+namespace mpx::test {
+namespace {
+
+// The two thermo-spring system of tests/data/two_thermo_springs.xml, written in C++.
+SceneSpec twoThermoSpringsInCode() {
+  SceneSpec scene;
+  scene.name = "two_thermo_springs";
+  scene.label = "two springs built in code";
+  scene.settings.dt = 0.2;
+  scene.settings.tEnd = 200;
+  scene.settings.thermalVariable = ThermalVariable::Entropy;
+  scene.add("anchor", {{"name", "origin"}, {"position", Vec3(0, 0, 0)}});
+  scene.add("mass", {{"name", "m1"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}, {"velocity", Vec3(0, 2, 0)}});
+  scene.add("mass", {{"name", "m2"}, {"mass", 1.0}, {"position", Vec3(2.2, 0, 0)}, {"velocity", Vec3(1, 0, 0)}});
+  for (const auto& [name, a, b, entropy] :
+       {std::tuple{"s1", "origin", "m1", 1.0}, std::tuple{"s2", "m1", "m2", 0.2}})
+    scene.add("thermo_spring", {{"name", name}, {"a", a}, {"b", b}, {"stiffness", 1.0}, {"coupling", 1.0},
+                                {"rest_length", 1.0}, {"heat_capacity", 1.0}, {"reference_temperature", 1.0},
+                                {"entropy", entropy}});
+  scene.add("heat_link", {{"name", "h12"}, {"a", "s1"}, {"b", "s2"}, {"conductivity", 1.0}});
+  return scene;
+}
+
+TEST(SceneBuilder, CodeAndXmlGiveTheSameModelAndTheSameRunBitForBit) {
+  const CompiledScene fromXml = loadScene(scenePath("two_thermo_springs.xml"));
+  const CompiledScene fromCode = compileScene(twoThermoSpringsInCode());
+  const Model &x = *fromXml.model, &c = *fromCode.model;
+  for (int b = 0; b < kBlockCount; ++b)
+    EXPECT_EQ(x.layout().size(static_cast<Block>(b)), c.layout().size(static_cast<Block>(b)));
+  EXPECT_EQ(x.components().size(), c.components().size());
+  EXPECT_EQ(x.thermalNodeNames(), c.thermalNodeNames());
+  EXPECT_EQ(x.initialState(), c.initialState());
+  EXPECT_EQ(x.dofScale(), c.dofScale());
+  const History hx = run(x, Scheme::Eem, 0.2, 4.0), hc = run(c, Scheme::Eem, 0.2, 4.0);
+  ASSERT_EQ(hx.states.size(), hc.states.size());
+  EXPECT_EQ(hx.states.back(), hc.states.back());
+}
+
+TEST(SceneBuilder, NumbersSurviveTheTextRoundTrip) {
+  for (double value : {0.1, 1.0 / 3.0, 6.02214076e23, -2.5e-308, 4.9e-324})
+    EXPECT_EQ(std::strtod(AttributeValue(value).text().c_str(), nullptr), value) << AttributeValue(value).text();
+}
+
+TEST(SceneBuilder, ErrorsInCodeBuiltScenesNameTheSceneAndTheElement) {
+  SceneSpec scene = twoThermoSpringsInCode();
+  scene.elements[1].set("mass", -1.0);
+  try {
+    compileScene(scene);
+    FAIL() << "a negative mass compiled";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("two springs built in code: element 2: <mass name=\"m1\">: attribute 'mass' "
+                                         "must be positive"),
+              std::string::npos)
+        << e.what();
+  }
+  SceneSpec unknown = twoThermoSpringsInCode();
+  unknown.add("sprung", {{"name", "x"}});
+  EXPECT_THROW(compileScene(unknown), InputError);
+  SceneSpec noStep = twoThermoSpringsInCode();
+  noStep.settings.dt = 0.0;
+  EXPECT_THROW(compileScene(noStep), InputError);
+}
+
+// An element that takes more dofs than it declared, or fewer, is a defect of its builder:
+// the compiler stops with a logic error instead of writing into another element's block.
+TEST(SceneBuilder, DofRangeRefusesMoreAndReportsLessThanDeclared) {
+  const Layout layout({6, 6, 2, 3, 0});
+  DofRange range(layout, DofDemand{3, 1, 0, 0}, DofDemand{3, 1, 2, 0});
+  EXPECT_EQ(range.take(Block::Position, 3), 3);
+  EXPECT_EQ(range.take(Block::Thermal, 1), 12 + 1);
+  EXPECT_THROW(range.take(Block::Thermal, 1), std::logic_error);
+  EXPECT_THROW(range.checkAllTaken("test"), std::logic_error);  // the internal dofs are missing
+  EXPECT_EQ(range.take(Block::Internal, 2), 14);
+  EXPECT_NO_THROW(range.checkAllTaken("test"));
+  EXPECT_THROW(range.take(Block::Velocity, 1), std::logic_error);
+}
+
+// Every element kind of the registry is in docs/scene-format.md, so a new kind cannot land
+// undocumented.
+TEST(SceneBuilder, EveryRegisteredElementIsDocumented) {
+  const std::string format = readFile(std::string(METRIPLEX_SOURCE_DIR) + "/docs/scene-format.md");
+  ASSERT_FALSE(format.empty());
+  std::string tags = elementTags();
+  for (std::size_t start = 0; start < tags.size();) {
+    const std::size_t end = std::min(tags.find(", ", start), tags.size());
+    const std::string tag = tags.substr(start, end - start);
+    EXPECT_NE(format.find("<" + tag), std::string::npos) << "<" << tag << "> is not in docs/scene-format.md";
+    start = end + 2;
+  }
+}
+
+TEST(SceneBuilder, XmlElementsThatTakeNoChildrenRejectThem) {
+  const std::string text = R"(<metriplex><simulation dt="0.1" t_end="1"/>
+<mass name="m" mass="1"><mass name="inner" mass="1"/></mass></metriplex>)";
+  try {
+    readXmlScene(text, "children.xml");
+    FAIL() << "a child element was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("children.xml:2: <mass name=\"m\">: <mass> takes no child elements"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mpx::test
