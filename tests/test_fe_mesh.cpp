@@ -5,6 +5,7 @@
 #include "engine/core/input_error.hpp"
 #include "models/scene/gmsh_reader.hpp"
 #include "models/fe/mesh_generators.hpp"
+#include "tools/output/surface_picture.hpp"
 #include "tools/output/vtk_writer.hpp"
 
 #include <gtest/gtest.h>

@@ -15,7 +15,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
-#include <sstream>
+#include <tuple>
 #include <string>
 #include <utility>
 
@@ -33,77 +33,77 @@ SceneSource sceneFile(const std::string& file) {
   };
 }
 
-// Scenes generated in code are compiled from their XML text; `label` names them in messages.
-SceneSource sceneText(std::string xml, std::string label) {
-  return [xml = std::move(xml), label = std::move(label)](std::optional<ThermalVariable> variable) {
-    return loadSceneText(xml, label, variable);
-  };
+// Scenes generated in code are built as a SceneSpec (no XML text) and compiled on demand.
+SceneSource sceneSpec(SceneSpec scene) {
+  return [scene = std::move(scene)](std::optional<ThermalVariable> variable) { return compileScene(scene, variable); };
+}
+
+// A spec with the run settings every generated scene shares.
+SceneSpec generatedScene(const std::string& name, double dt, double tEnd) {
+  SceneSpec scene;
+  scene.name = scene.label = name;
+  scene.settings.dt = dt;
+  scene.settings.tEnd = tEnd;
+  return scene;
 }
 
 // A chain fixed to an anchor at the origin: masses along x at spacing 1.1 (springs pre-
 // stretched by 0.1) with a transverse velocity pattern, a thermo-spring between consecutive
 // points, temperatures varying along the chain and heat links between neighbouring springs.
-std::string thermoSpringChainXml(int masses, double dt) {
-  std::ostringstream xml;
-  xml << "<metriplex name=\"thermo_spring_chain\">\n"
-      << "  <simulation dt=\"" << dt << "\" t_end=\"100\" thermal_variable=\"entropy\"/>\n"
-      << "  <anchor name=\"origin\" position=\"0 0 0\"/>\n";
+SceneSpec thermoSpringChain(int masses, double dt) {
+  SceneSpec scene = generatedScene("thermo_spring_chain", dt, 100);
+  scene.settings.thermalVariable = ThermalVariable::Entropy;
+  scene.add("anchor", {{"name", "origin"}, {"position", Vec3::Zero()}});
   const auto point = [](int i) { return i == 0 ? std::string("origin") : "m" + std::to_string(i); };
   for (int i = 1; i <= masses; ++i) {
-    xml << "  <mass name=\"" << point(i) << "\" mass=\"1\" position=\"" << 1.1 * i << " 0 0\" velocity=\"0 "
-        << 0.2 * std::sin(0.3 * i) << ' ' << 0.1 * std::cos(0.7 * i) << "\"/>\n"
-        << "  <thermo_spring name=\"s" << i << "\" a=\"" << point(i - 1) << "\" b=\"" << point(i)
-        << "\" stiffness=\"1\" coupling=\"1\" rest_length=\"1\" heat_capacity=\"1\""
-        << " reference_temperature=\"1\" temperature=\"" << 1.0 + 0.5 * std::sin(i) << "\"/>\n";
+    const std::string spring = "s" + std::to_string(i);
+    scene.add("mass", {{"name", point(i)}, {"mass", 1.0}, {"position", Vec3(1.1 * i, 0, 0)},
+                       {"velocity", Vec3(0, 0.2 * std::sin(0.3 * i), 0.1 * std::cos(0.7 * i))}});
+    scene.add("thermo_spring", {{"name", spring}, {"a", point(i - 1)}, {"b", point(i)}, {"stiffness", 1.0},
+                                {"coupling", 1.0}, {"rest_length", 1.0}, {"heat_capacity", 1.0},
+                                {"reference_temperature", 1.0}, {"temperature", 1.0 + 0.5 * std::sin(i)}});
     if (i > 1)
-      xml << "  <heat_link name=\"h" << i << "\" a=\"s" << i - 1 << "\" b=\"s" << i << "\" conductivity=\"1\"/>\n";
+      scene.add("heat_link", {{"name", "h" + std::to_string(i)}, {"a", "s" + std::to_string(i - 1)}, {"b", spring},
+                              {"conductivity", 1.0}});
   }
-  xml << "</metriplex>\n";
-  return xml.str();
+  return scene;
 }
 
 // A chain of rigid links hinged to an anchor at the origin, released from rest horizontal in
 // gravity: link i (1 kg, a 0.5 x 0.05 x 0.05 m box) is centred at (0.25 + 0.5 i, 0, 0) and
 // joined to its predecessor by a revolute joint about y at their common end; `enforcement`
-// and `stiffness` become the scene's <constraints> default.
-std::string rigidChainXml(int links, const std::string& enforcement, double stiffness, double dt) {
+// and `stiffness` are the scene's constraint defaults.
+SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, double dt) {
   const double mass = 1.0, length = 0.5, width = 0.05;
   const double axial = mass * (width * width + width * width) / 12;
   const double transverse = mass * (length * length + width * width) / 12;
-  std::ostringstream xml;
-  xml.precision(17);
-  xml << "<metriplex name=\"rigid_chain\">\n"
-      << "  <simulation dt=\"" << dt << "\" t_end=\"100\"/>\n"
-      << "  <constraints enforcement=\"" << enforcement << "\" stiffness=\"" << stiffness << "\"/>\n"
-      << "  <gravity g=\"0 0 -9.81\"/>\n"
-      << "  <anchor name=\"origin\" position=\"0 0 0\"/>\n";
+  SceneSpec scene = generatedScene("rigid_chain", dt, 100);
+  scene.constraints = {enforcement, stiffness};
+  scene.gravity = Vec3(0, 0, -9.81);
+  scene.add("anchor", {{"name", "origin"}, {"position", Vec3::Zero()}});
   const auto link = [](int i) { return i < 0 ? std::string("origin") : "l" + std::to_string(i); };
-  for (int i = 0; i < links; ++i)
-    xml << "  <body name=\"" << link(i) << "\" mass=\"" << mass << "\" inertia=\"" << axial << ' ' << transverse
-        << ' ' << transverse << "\" position=\"" << length * (i + 0.5) << " 0 0\"/>\n"
-        << "  <joint name=\"j" << i << "\" type=\"revolute\" a=\"" << link(i - 1) << "\" b=\"" << link(i)
-        << "\" anchor=\"" << length * i << " 0 0\" axis=\"0 1 0\"/>\n";
-  xml << "</metriplex>\n";
-  return xml.str();
+  for (int i = 0; i < links; ++i) {
+    scene.add("body", {{"name", link(i)}, {"mass", mass}, {"inertia", Vec3(axial, transverse, transverse)},
+                       {"position", Vec3(length * (i + 0.5), 0, 0)}});
+    scene.add("joint", {{"name", "j" + std::to_string(i)}, {"type", "revolute"}, {"a", link(i - 1)}, {"b", link(i)},
+                        {"anchor", Vec3(length * i, 0, 0)}, {"axis", Vec3::UnitY()}});
+  }
+  return scene;
 }
 
 // The tumbling L-block of scenes/lblock_elastic.xml (Neo-Hooke, two opposite dead tractions
 // with the hat profile of period 5) on mesh level `level`; `viscous` adds the Maxwell branch
 // of scenes/lblock_viscoelastic.xml.
-std::string lblockXml(int level, bool viscous, double dt) {
-  std::ostringstream xml;
-  xml << "<metriplex name=\"lblock\">\n"
-      << "  <simulation dt=\"" << dt << "\" t_end=\"50\"/>\n"
-      << "  <solid name=\"block\" mesh=\"lblock\" level=\"" << level << "\" material=\"neo_hooke\""
-      << " young=\"2.26115e3\" poisson=\"0.395469\" density=\"10\"";
-  if (viscous) xml << " branch_lambda=\"227.2\" branch_mu=\"49.875\" viscosity=\"100\"";
-  xml << "/>\n"
-      << "  <traction name=\"push_top\" solid=\"block\" surface=\"load_y10\" total_force=\"256 512 768\""
-      << " profile=\"hat\" period=\"5\"/>\n"
-      << "  <traction name=\"push_side\" solid=\"block\" surface=\"load_x6\" total_force=\"-256 -512 -768\""
-      << " profile=\"hat\" period=\"5\"/>\n"
-      << "</metriplex>\n";
-  return xml.str();
+SceneSpec lblock(int level, bool viscous, double dt) {
+  SceneSpec scene = generatedScene("lblock", dt, 50);
+  ElementSpec& block = scene.add("solid", {{"name", "block"}, {"mesh", "lblock"}, {"level", level},
+                                           {"material", "neo_hooke"}, {"young", 2.26115e3}, {"poisson", 0.395469},
+                                           {"density", 10.0}});
+  if (viscous) block.set("branch_lambda", 227.2).set("branch_mu", 49.875).set("viscosity", 100.0);
+  for (const auto& [name, surface, sign] : {std::tuple{"push_top", "load_y10", 1.0}, std::tuple{"push_side", "load_x6", -1.0}})
+    scene.add("traction", {{"name", name}, {"solid", "block"}, {"surface", surface},
+                           {"total_force", Vec3(256, 512, 768) * sign}, {"profile", "hat"}, {"period", 5.0}});
+  return scene;
 }
 
 // One trajectory of a scene at a fixed dt: each step advances z at time t into zNext, which
@@ -303,7 +303,7 @@ void loadedSolidBenchmark(benchmark::State& state, const std::shared_ptr<LoadedS
 // steps per run.
 void registerLBlock(const std::string& name, int level, bool viscous, int steps) {
   auto solid = std::make_shared<LoadedSolid>();
-  solid->scene = std::make_shared<const CompiledScene>(loadSceneText(lblockXml(level, viscous, 0.1), name));
+  solid->scene = std::make_shared<const CompiledScene>(compileScene(lblock(level, viscous, 0.1)));
   solid->loadedTime = 1.0;
   solid->loadingDt = 0.5;
   benchmark::RegisterBenchmark((name + "/level" + std::to_string(level) + "/eem").c_str(), loadedSolidBenchmark, solid)
@@ -322,12 +322,12 @@ int main(int argc, char** argv) {
                 {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
   registerCases("thermo_visco_elastic", sceneFile("thermo_visco_elastic.xml"),
                 {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
-  registerCases("thermo_spring_chain_1000", sceneText(thermoSpringChainXml(1000, 0.05), "thermo_spring_chain"),
+  registerCases("thermo_spring_chain_1000", sceneSpec(thermoSpringChain(1000, 0.05)),
                 {kEemEntropy, kEemTemperature, kMidpoint});
   // rigid multibody: a long open chain under both enforcements, and a spatial closed loop
-  registerCases("rigid_chain_50", sceneText(rigidChainXml(50, "augmented_lagrangian", 1e4, 1e-3), "rigid_chain"),
+  registerCases("rigid_chain_50", sceneSpec(rigidChain(50, Enforcement::AugmentedLagrangian, 1e4, 1e-3)),
                 {kEem});
-  registerCases("rigid_chain_50_penalty", sceneText(rigidChainXml(50, "penalty", 1e8, 1e-3), "rigid_chain"),
+  registerCases("rigid_chain_50_penalty", sceneSpec(rigidChain(50, Enforcement::Penalty, 1e8, 1e-3)),
                 {kEem});
   registerCases("slider_crank_spatial", sceneFile("slider_crank_spatial.xml"), {kEem, kMidpoint});
   // finite-element solids: the tumbling L-block by mesh level (90 to 14 400 nodes)

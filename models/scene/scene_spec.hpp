@@ -35,12 +35,15 @@ class AttributeValue {
   AttributeValue(double value);
   AttributeValue(int value);
   AttributeValue(bool value) : text_(value ? "true" : "false") {}
-  AttributeValue(const Vec3& value);
+  // a 3-vector, or any Eigen expression of one (Vec3::UnitZ(), 2 * v, ...)
+  template <class Derived>
+  AttributeValue(const Eigen::MatrixBase<Derived>& value) : AttributeValue(Vec3(value), 0) {}
   AttributeValue(const std::vector<double>& values);
   AttributeValue(const Eigen::Quaterniond& rotation);  // "w x y z"
   const std::string& text() const { return text_; }
 
  private:
+  AttributeValue(const Vec3& value, int);
   std::string text_;
 };
 

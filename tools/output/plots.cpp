@@ -1,10 +1,11 @@
 #include "tools/output/plots.hpp"
 
+#include "tools/output/gnuplot.hpp"
+
 #include <fmt/format.h>
 #include <fmt/os.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <stdexcept>
 
 namespace mpx {
@@ -71,9 +72,7 @@ void renderPlots(const std::filesystem::path& dir, const std::string& sceneName,
     out.print("set format y '%g'\nset xlabel 'time [s]'\nset ylabel 'S(t) - S(0) [J/K]'\n");
     out.print("{}", plotCommand(seriesFiles, seriesLabels, "1:3", "lines lw 2"));
   }
-  const std::string command = fmt::format("gnuplot '{}' 2> '{}'", script.string(), (dir / "gnuplot.log").string());
-  if (std::system(command.c_str()) != 0)
-    throw std::runtime_error("gnuplot failed to render the plots; see " + (dir / "gnuplot.log").string());
+  runGnuplot(script, dir / "gnuplot.log");
 }
 
 }  // namespace mpx

@@ -1,5 +1,7 @@
 #include "tools/output/solid_frames.hpp"
 
+#include "tools/output/surface_picture.hpp"
+
 #include <fmt/format.h>
 
 namespace mpx {

@@ -1,6 +1,5 @@
 #pragma once
-// Output of finite-element results: VTK XML unstructured grids (.vtu), ParaView time series (.pvd) and a quick PNG
-// view of the deformed boundary rendered with gnuplot.
+// Output of finite-element results for ParaView: VTK XML unstructured grids (.vtu) and time series (.pvd).
 #include "models/fe/mesh.hpp"
 
 #include <string>
@@ -35,12 +34,5 @@ class PvdSeries {
   std::string path_;
   std::vector<std::pair<double, std::string>> frames_;  // (time, file relative to the .pvd)
 };
-
-// Render the boundary surface of the mesh at `positions` as a PNG with gnuplot (pngcairo, pm3d), coloured by a
-// per-cell scalar (the colour of a boundary face is its cell's value), viewed from (az, el) = (60, 30)-ish with equal
-// axis scaling, title `title`. Writes the gnuplot script and data into a temp dir next to the png (removed after
-// success), runs `gnuplot` via std::system; throws std::runtime_error if gnuplot fails.
-void renderSurfacePng(const std::string& pngPath, const Mesh& mesh, const std::vector<Vec3>& positions,
-                      const std::vector<double>& cellScalar, const std::string& scalarName, const std::string& title);
 
 }  // namespace mpx

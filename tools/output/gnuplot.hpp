@@ -1,0 +1,16 @@
+#pragma once
+// The one way output writers run gnuplot (Debian package gnuplot-nox, installed by
+// tools/install-deps.sh): a script file, its messages kept in a log.
+#include <filesystem>
+#include <string>
+
+namespace mpx {
+
+// Text as a single-quoted gnuplot string (a quote inside is doubled).
+std::string gnuplotQuoted(const std::string& text);
+
+// Run gnuplot on `script`, its stderr into `log`. Throws std::runtime_error with the log's
+// text if gnuplot fails.
+void runGnuplot(const std::filesystem::path& script, const std::filesystem::path& log);
+
+}  // namespace mpx
