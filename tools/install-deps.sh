@@ -3,7 +3,7 @@
 set -eu
 packages="build-essential cmake pkg-config libeigen3-dev libsundials-dev libsuitesparse-dev
   libopenblas0-pthread libtinyxml2-dev liburdfdom-dev libgtest-dev libbenchmark-dev libcli11-dev
-  libfmt-dev gnuplot-nox"
+  libfmt-dev gnuplot-nox clang-format"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
