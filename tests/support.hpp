@@ -25,9 +25,12 @@ inline std::string readFile(const std::string& path) {
 // Test-name fragment of a one-step scheme.
 inline std::string schemeName(Scheme scheme) {
   switch (scheme) {
-    case Scheme::Eem: return "eem";
-    case Scheme::Midpoint: return "midpoint";
-    case Scheme::Trapezoidal: return "trapezoidal";
+    case Scheme::Eem:
+      return "eem";
+    case Scheme::Midpoint:
+      return "midpoint";
+    case Scheme::Trapezoidal:
+      return "trapezoidal";
   }
   return "unknown";
 }
@@ -63,8 +66,8 @@ inline History run(const Model& model, Scheme scheme, double dt, double tEnd, Ne
 inline double maxBalanceDrift(const History& h) {
   double drift = 0.0;
   for (std::size_t n = 0; n < h.energy.size(); ++n)
-    drift = std::max(drift, std::abs(h.energy[n] + h.dissipated[n] - h.externalWork[n] - h.boundaryHeat[n] -
-                                     h.energy[0]));
+    drift =
+        std::max(drift, std::abs(h.energy[n] + h.dissipated[n] - h.externalWork[n] - h.boundaryHeat[n] - h.energy[0]));
   return drift;
 }
 

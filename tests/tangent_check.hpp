@@ -4,8 +4,8 @@
 // by the dofs' magnitudes.
 #include "engine/core/model.hpp"
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include <functional>
 #include <random>
@@ -33,7 +33,7 @@ using ResidualFunction = std::function<VectorXd(const VectorXd&)>;
 
 // Central differences of `residual` at x, column j with step relativeStep * magnitude_j.
 inline MatrixXd centralDifferences(const ResidualFunction& residual, const VectorXd& x, const VectorXd& magnitude,
-                            double relativeStep) {
+                                   double relativeStep) {
   MatrixXd jacobian(x.size(), x.size());
   for (Eigen::Index j = 0; j < x.size(); ++j) {
     const double h = relativeStep * magnitude[j];
@@ -72,9 +72,9 @@ inline void expectTangentMatches(const Model& model, const MatrixXd& analytic, c
   const Mismatch worst = worstRowMismatch(analytic, numeric, magnitude);
   const Layout& layout = model.layout();
   EXPECT_LT(worst.relative, tolerance) << "row " << worst.row << " (" << blockName(layout.blockOf(worst.row))
-                                        << "), column " << worst.col << " (" << blockName(layout.blockOf(worst.col))
-                                        << "): tangent " << analytic(worst.row, worst.col) << ", finite differences "
-                                        << numeric(worst.row, worst.col);
+                                       << "), column " << worst.col << " (" << blockName(layout.blockOf(worst.col))
+                                       << "): tangent " << analytic(worst.row, worst.col) << ", finite differences "
+                                       << numeric(worst.row, worst.col);
 }
 
 }  // namespace mpx::test

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <malloc.h>
 #include <atomic>
 #include <cerrno>
 #include <cstdlib>
-#include <malloc.h>
 #include <string>
 #include <tuple>
 

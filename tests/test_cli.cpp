@@ -97,8 +97,7 @@ class CliTest : public ::testing::Test {
   // Run `metriplex arguments` with stdout and stderr captured to files.
   Invocation metriplex(const std::string& arguments) const {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command =
-        quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
+    const std::string command = quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
     const int status = std::system(command.c_str());
     Invocation result;
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -127,76 +126,146 @@ const std::vector<BadScene> kBadScenes = {
     {"MalformedXml",
      "<?xml version=\"1.0\"?>\n<metriplex name=\"cli\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n"
      "  <mass name=\"bob\" mass=\"1\">\n</metriplex>\n",
-     "", 4, {"malformed XML", "mass"}},
-    {"WrongRoot", "<?xml version=\"1.0\"?>\n<scene name=\"cli\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n</scene>\n",
-     "", 2, {"root element", "<metriplex>", "<scene>"}},
-    {"UnknownElement", sceneWith("  <spring_damper name=\"sd\" a=\"pivot\" b=\"pivot\"/>"), "", 5,
+     "",
+     4,
+     {"malformed XML", "mass"}},
+    {"WrongRoot",
+     "<?xml version=\"1.0\"?>\n<scene name=\"cli\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n</scene>\n",
+     "",
+     2,
+     {"root element", "<metriplex>", "<scene>"}},
+    {"UnknownElement",
+     sceneWith("  <spring_damper name=\"sd\" a=\"pivot\" b=\"pivot\"/>"),
+     "",
+     5,
      {"<spring_damper", "unknown element"}},
-    {"MisspeltAttribute", sceneWith("  <mass name=\"bob\" mass=\"1\" positon=\"1 0 0\"/>"), "", 5,
+    {"MisspeltAttribute",
+     sceneWith("  <mass name=\"bob\" mass=\"1\" positon=\"1 0 0\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "unknown attribute 'positon'"}},
-    {"MisspeltRootAttribute", replaced(kSwingScene, "name=\"cli\"", "nmae=\"cli\""), "", 2,
+    {"MisspeltRootAttribute",
+     replaced(kSwingScene, "name=\"cli\"", "nmae=\"cli\""),
+     "",
+     2,
      {"<metriplex", "unknown attribute 'nmae'"}},
-    {"MissingRequiredAttribute", sceneWith("  <mass name=\"bob\" position=\"1 0 0\"/>"), "", 5,
+    {"MissingRequiredAttribute",
+     sceneWith("  <mass name=\"bob\" position=\"1 0 0\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "missing required attribute 'mass'"}},
-    {"NegativeMass", sceneWith("  <mass name=\"bob\" mass=\"-2\" position=\"1 0 0\"/>"), "", 5,
+    {"NegativeMass",
+     sceneWith("  <mass name=\"bob\" mass=\"-2\" position=\"1 0 0\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "'mass' must be positive"}},
     {"ZeroRestLength",
      sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>\n"
                "  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"10\" rest_length=\"0\"/>"),
-     "", 6, {"<spring name=\"s\">", "'rest_length' must be positive"}},
-    {"NegativeHeatCapacity", sceneWith("  <reservoir name=\"env\" heat_capacity=\"-1\" temperature=\"1\"/>"), "", 5,
+     "",
+     6,
+     {"<spring name=\"s\">", "'rest_length' must be positive"}},
+    {"NegativeHeatCapacity",
+     sceneWith("  <reservoir name=\"env\" heat_capacity=\"-1\" temperature=\"1\"/>"),
+     "",
+     5,
      {"<reservoir name=\"env\">", "'heat_capacity' must be positive"}},
-    {"ZeroTemperature", sceneWith("  <fixed_temperature name=\"wall\" temperature=\"0\"/>"), "", 5,
+    {"ZeroTemperature",
+     sceneWith("  <fixed_temperature name=\"wall\" temperature=\"0\"/>"),
+     "",
+     5,
      {"<fixed_temperature name=\"wall\">", "'temperature' must be positive"}},
-    {"NanValue", sceneWith("  <mass name=\"bob\" mass=\"nan\" position=\"1 0 0\"/>"), "", 5,
+    {"NanValue",
+     sceneWith("  <mass name=\"bob\" mass=\"nan\" position=\"1 0 0\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "'mass' must be finite"}},
-    {"InfValue", sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 inf 0\"/>"), "", 5,
+    {"InfValue",
+     sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 inf 0\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "'position' must be finite"}},
     {"NonNumericValue",
      sceneWith("  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>\n"
                "  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"stiff\" rest_length=\"1\"/>"),
-     "", 6, {"<spring name=\"s\">", "'stiffness'", "'stiff' is not a number"}},
-    {"VectorWithTwoNumbers", sceneWith("  <mass name=\"bob\" mass=\"1\" velocity=\"0 1\"/>"), "", 5,
+     "",
+     6,
+     {"<spring name=\"s\">", "'stiffness'", "'stiff' is not a number"}},
+    {"VectorWithTwoNumbers",
+     sceneWith("  <mass name=\"bob\" mass=\"1\" velocity=\"0 1\"/>"),
+     "",
+     5,
      {"<mass name=\"bob\">", "'velocity' needs 3 numbers, got 2"}},
-    {"DuplicateName", sceneWith("  <mass name=\"pivot\" mass=\"1\" position=\"1 0 0\"/>"), "", 5,
+    {"DuplicateName",
+     sceneWith("  <mass name=\"pivot\" mass=\"1\" position=\"1 0 0\"/>"),
+     "",
+     5,
      {"<mass name=\"pivot\">", "'pivot' is already used on line 4"}},
     {"UndeclaredMass",
      sceneWith("  <spring name=\"s\" a=\"pivot\" b=\"bob\" stiffness=\"10\" rest_length=\"1\"/>\n"
                "  <mass name=\"bob\" mass=\"1\" position=\"1 0 0\"/>"),
-     "", 5, {"<spring name=\"s\">", "'b'", "no mass or anchor named 'bob'"}},
+     "",
+     5,
+     {"<spring name=\"s\">", "'b'", "no mass or anchor named 'bob'"}},
     {"HeatLinkToNonThermalNode",
      sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" temperature=\"1\"/>\n"
                "  <heat_link name=\"h\" a=\"env\" b=\"pivot\" conductivity=\"1\"/>"),
-     "", 6, {"<heat_link name=\"h\">", "'b'", "no thermal node named 'pivot'"}},
-    {"EntropyFormWithCurvedStiffness", kSwingScene, "--integrator eem-entropy", 6,
+     "",
+     6,
+     {"<heat_link name=\"h\">", "'b'", "no thermal node named 'pivot'"}},
+    {"EntropyFormWithCurvedStiffness",
+     kSwingScene,
+     "--integrator eem-entropy",
+     6,
      {"<thermo_spring name=\"spring\">", "stiffness_curvature"}},
     {"SceneEntropyIntegratorWithCurvedStiffness",
-     replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"eem-entropy\""), "", 6,
+     replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"eem-entropy\""),
+     "",
+     6,
      {"<thermo_spring name=\"spring\">", "stiffness_curvature"}},
-    {"MissingSimulation", "<?xml version=\"1.0\"?>\n<metriplex name=\"cli\">\n  <anchor name=\"pivot\"/>\n</metriplex>\n",
-     "", 2, {"missing <simulation"}},
-    {"DuplicateSimulation", sceneWith("  <simulation dt=\"0.5\" t_end=\"1\"/>\n" + kSwingElements), "", 5,
+    {"MissingSimulation",
+     "<?xml version=\"1.0\"?>\n<metriplex name=\"cli\">\n  <anchor name=\"pivot\"/>\n</metriplex>\n",
+     "",
+     2,
+     {"missing <simulation"}},
+    {"DuplicateSimulation",
+     sceneWith("  <simulation dt=\"0.5\" t_end=\"1\"/>\n" + kSwingElements),
+     "",
+     5,
      {"<simulation"}},
-    {"UnknownSceneIntegrator", replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"rk4\""), "", 3,
+    {"UnknownSceneIntegrator",
+     replaced(kSwingScene, "t_end=\"1\"", "t_end=\"1\" integrator=\"rk4\""),
+     "",
+     3,
      {"<simulation>", "integrator", "'rk4'"}},
     {"NothingToSimulate", sceneWith(""), "", 2, {"<metriplex"}},
     {"ReservoirEntropyOverflowingTemperature",
-     sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" entropy=\"1000\"/>"), "", 5,
+     sceneWith("  <reservoir name=\"env\" heat_capacity=\"1\" entropy=\"1000\"/>"),
+     "",
+     5,
      {"<reservoir name=\"env\">", "entropy"}},
     {"SolidWithNonPhysicalPoisson",
-     sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.5\" density=\"1\"/>"), "", 5,
+     sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.5\" density=\"1\"/>"),
+     "",
+     5,
      {"<solid name=\"b\">", "Poisson"}},
     {"SolidMeshFileMissing",
-     sceneWith("  <solid name=\"b\" mesh=\"missing.msh\" young=\"10\" poisson=\"0.3\" density=\"1\"/>"), "", 5,
+     sceneWith("  <solid name=\"b\" mesh=\"missing.msh\" young=\"10\" poisson=\"0.3\" density=\"1\"/>"),
+     "",
+     5,
      {"<solid name=\"b\">", "missing.msh", "cannot open"}},
     {"ClampOnUnknownSurface",
      sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
                "  <clamp solid=\"b\" surface=\"top\"/>"),
-     "", 6, {"<clamp>", "no surface or node set 'top'", "x0"}},
+     "",
+     6,
+     {"<clamp>", "no surface or node set 'top'", "x0"}},
     {"TractionWithoutLoad",
      sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
                "  <traction name=\"t\" solid=\"b\" surface=\"x1\"/>"),
-     "", 6, {"<traction name=\"t\">", "'traction'", "'total_force'"}},
+     "",
+     6,
+     {"<traction name=\"t\">", "'traction'", "'total_force'"}},
 };
 
 class BadSceneTest : public CliTest, public ::testing::WithParamInterface<BadScene> {};
@@ -281,10 +350,10 @@ INSTANTIATE_TEST_SUITE_P(Cli, BadOptionsTest, ::testing::ValuesIn(kBadOptions),
 void expectCompleteHistory(const std::vector<std::string>& lines, std::size_t rows) {
   ASSERT_EQ(lines.size(), rows + 1);
   const std::vector<std::string> header = splitFields(lines.front());
-  for (const char* column : {"time", "energy", "entropy", "dissipated_energy", "external_work", "boundary_heat",
-                             "momentum_x", "momentum_y", "momentum_z", "angular_momentum_x", "angular_momentum_y",
-                             "angular_momentum_z", "newton_iterations", "cutbacks", "constraint_violation",
-                             "temperature_spring", "temperature_wall"})
+  for (const char* column :
+       {"time", "energy", "entropy", "dissipated_energy", "external_work", "boundary_heat", "momentum_x", "momentum_y",
+        "momentum_z", "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "newton_iterations", "cutbacks",
+        "constraint_violation", "temperature_spring", "temperature_wall"})
     EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
   for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(splitFields(lines[i]).size(), header.size()) << lines[i];
 }
@@ -306,7 +375,8 @@ TEST_F(CliTest, SolidRunWritesAParaViewSeriesAndAPicture) {
   const std::string scene = sceneWith(
       "  <solid name=\"block\" mesh=\"box\" size=\"2 1 1\" cells=\"2 1 1\" young=\"1000\" poisson=\"0.3\" "
       "density=\"10\" angular_velocity=\"0 0 1\"/>");
-  const Invocation r = metriplex("run " + quoted(writeScene(scene)) + " --output-interval 0.5 --out " + quoted(outDir()));
+  const Invocation r =
+      metriplex("run " + quoted(writeScene(scene)) + " --output-interval 0.5 --out " + quoted(outDir()));
   ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
   const std::string pvd = readFile(outDir() / "block.pvd");
   for (int frame = 0; frame < 3; ++frame) {  // t = 0, 0.5, 1
@@ -325,8 +395,10 @@ TEST_F(CliTest, SolidRunWritesAParaViewSeriesAndAPicture) {
 
 // --dt and --t-end replace the scene's step and end time
 TEST_F(CliTest, StepAndEndTimeOptionsOverrideTheScene) {
-  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) + " --integrator midpoint --dt 0.25 "
-                                 "--t-end 0.5 --out " + quoted(outDir()));
+  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) +
+                                 " --integrator midpoint --dt 0.25 "
+                                 "--t-end 0.5 --out " +
+                                 quoted(outDir()));
   ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
   const std::vector<std::string> lines = splitLines(readFile(outDir() / "history.csv"));
   ASSERT_NO_FATAL_FAILURE(expectCompleteHistory(lines, 3));

@@ -87,9 +87,7 @@ TEST(ComponentContract, ClaimingKinematicRowsTurnsCondensationOffAndSaysWhy) {
   EXPECT_EQ(K(0, 9), kBogus);
   EXPECT_EQ(integrator.linearSolver().condensedSize(), 12);
   const std::string reason = integrator.linearSolver().describe();
-  EXPECT_NE(reason.find("solved whole because the kinematic row of position dof "),
-            std::string::npos)
-      << reason;
+  EXPECT_NE(reason.find("solved whole because the kinematic row of position dof "), std::string::npos) << reason;
 }
 
 TEST(ComponentContract, FlowsOfAllComponentsAreSummed) {

@@ -30,7 +30,8 @@ Eigen::VectorXd finalState(const Model& model, Scheme scheme, double dt) {
 // least-squares slope of log(error) against log(dt)
 double slope(const std::vector<double>& dts, const std::vector<double>& errors) {
   double mx = 0, my = 0;
-  for (std::size_t i = 0; i < dts.size(); ++i) mx += std::log(dts[i]) / dts.size(), my += std::log(errors[i]) / dts.size();
+  for (std::size_t i = 0; i < dts.size(); ++i)
+    mx += std::log(dts[i]) / dts.size(), my += std::log(errors[i]) / dts.size();
   double sxy = 0, sxx = 0;
   for (std::size_t i = 0; i < dts.size(); ++i) {
     sxy += (std::log(dts[i]) - mx) * (std::log(errors[i]) - my);
@@ -46,7 +47,8 @@ TEST_P(ConvergenceOrder, IsTwo) {
   const CompiledScene scene = loadScene(scenePath(c.scene), c.variable);
   const Eigen::VectorXd reference = finalState(*scene.model, c.scheme, kReferenceStep);
   std::vector<double> dts(std::begin(kSteps), std::end(kSteps)), errors;
-  for (double dt : dts) errors.push_back((finalState(*scene.model, c.scheme, dt) - reference).lpNorm<Eigen::Infinity>());
+  for (double dt : dts)
+    errors.push_back((finalState(*scene.model, c.scheme, dt) - reference).lpNorm<Eigen::Infinity>());
   const double order = slope(dts, errors);
   std::printf("%s on %s: errors", c.label, c.scene);
   for (double e : errors) std::printf(" %.3e", e);

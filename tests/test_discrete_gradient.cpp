@@ -119,8 +119,7 @@ std::vector<GradientCase> gradientCases() {
       makeCase("hooke_branch_energy", energyOf(hooke), 0b101u, hookeA, hookeB, unit),
       makeCase("thermo_temperature_energy", energyOf(thermo), 0b011u, temperatureA, temperatureB, unit),
       makeCase("thermo_temperature_entropy", entropyOf(thermo), 0b011u, temperatureA, temperatureB, unit),
-      makeCase("thermo_maxwell_temperature_energy", energyOf(thermoMaxwell), 0b111u, temperatureA, temperatureB,
-               unit),
+      makeCase("thermo_maxwell_temperature_energy", energyOf(thermoMaxwell), 0b111u, temperatureA, temperatureB, unit),
       makeCase("thermo_maxwell_temperature_entropy", entropyOf(thermoMaxwell), 0b111u, temperatureA, temperatureB,
                unit),
       makeCase("thermo_entropy_energy", energyOf(thermoEntropy), 0b011u, entropyA, entropyB, unit),
@@ -234,7 +233,9 @@ TEST_P(DiscreteGradientTest, LinearisationMatchesFiniteDifferences) {
   const Mat3 numeric = centralJacobian([&](const Vec3& b) { return at(b).grad; }, c().b, c().scale, c().mask);
   const Mat3 analytic = at(c().b).dGradDb;
   EXPECT_LE((analytic - numeric).cwiseAbs().maxCoeff(), 1e-6 * analytic.cwiseAbs().maxCoeff())
-      << "analytic\n" << analytic << "\nfinite differences\n" << numeric;
+      << "analytic\n"
+      << analytic << "\nfinite differences\n"
+      << numeric;
 }
 
 // Either side of kQuotientSwitch (relative increments 0.5x and 2x the switch): directionality
@@ -274,7 +275,9 @@ TEST(LawJets, GradientAndHessianMatchFiniteDifferences) {
       EXPECT_LE((jet.grad - grad).cwiseAbs().maxCoeff(), 1e-7 * (std::abs(jet.value) + jet.grad.norm()))
           << c.name << " gradient at " << x.transpose() << ": " << jet.grad.transpose() << " vs " << grad.transpose();
       EXPECT_LE((jet.hess - hess).cwiseAbs().maxCoeff(), 1e-7 * (jet.grad.norm() + jet.hess.norm()))
-          << c.name << " Hessian at " << x.transpose() << ":\n" << jet.hess << "\nvs\n" << hess;
+          << c.name << " Hessian at " << x.transpose() << ":\n"
+          << jet.hess << "\nvs\n"
+          << hess;
       EXPECT_EQ((jet.hess - jet.hess.transpose()).norm(), 0.0) << c.name << " Hessian not symmetric";
     }
   }

@@ -9,8 +9,8 @@
 #include "engine/stepping/method.hpp"
 #include "models/fe/material.hpp"
 
-#include <Eigen/SparseLU>
 #include <gtest/gtest.h>
+#include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
@@ -43,7 +43,8 @@ std::size_t indexAt(const History& h, double t) {
 // max_{n >= from} |s_n - s_from| / scale
 double driftAfter(const std::vector<double>& series, std::size_t from, double scale) {
   double drift = 0.0;
-  for (std::size_t n = from; n < series.size(); ++n) drift = std::max(drift, std::abs(series[n] - series[from]) / scale);
+  for (std::size_t n = from; n < series.size(); ++n)
+    drift = std::max(drift, std::abs(series[n] - series[from]) / scale);
   return drift;
 }
 
@@ -78,7 +79,8 @@ double solidMass(const CompiledScene& scene) {
   const SolidPlacement& solid = scene.solids.front();
   VectorXd z = scene.model->initialState();
   z.segment(scene.model->layout().offset(Block::Velocity), scene.model->layout().size(Block::Velocity)).setZero();
-  for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n) z[solid.firstPositionDof + 3 * n + solid.velocityShift] = 1.0;
+  for (std::size_t n = 0; n < solid.mesh->nodes.size(); ++n)
+    z[solid.firstPositionDof + 3 * n + solid.velocityShift] = 1.0;
   Measures measures;
   scene.model->measure(z, measures);
   return measures.momentum.x();
@@ -121,7 +123,8 @@ void PrintTo(const CellCase& c, std::ostream* out) { *out << c.name << "_" << sc
 std::string oneCell(const CellCase& c) {
   return std::string(R"(<metriplex name="one_cell"><simulation dt="0.1" t_end="10"/>
     <solid name="cell" young="1000" poisson="0.3" density="10" velocity="0.1 -0.2 0.3"
-           angular_velocity="0.5 0.2 -0.4" )") + c.mesh + " " + c.material + "/></metriplex>";
+           angular_velocity="0.5 0.2 -0.4" )") +
+         c.mesh + " " + c.material + "/></metriplex>";
 }
 
 class CellTangent : public ::testing::TestWithParam<CellCase> {};
@@ -154,7 +157,8 @@ std::vector<CellCase> cellCases() {
       {"neo_hooke_viscous", R"(material="neo_hooke" branch_lambda="200" branch_mu="50" viscosity="100")"}};
   std::vector<CellCase> cases;
   for (const auto& [name, material] : laws)
-    for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint}) cases.push_back({name, material, scheme, R"(mesh="box" cells="1 1 1")", 5e-2});
+    for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint})
+      cases.push_back({name, material, scheme, R"(mesh="box" cells="1 1 1")", 5e-2});
   // the bar's tetrahedra are 0.5 across in a body 4 long: a smaller perturbation keeps them uninverted
   cases.push_back({"tet4_neo_hooke_viscous", laws[2].second, Scheme::Eem, R"(mesh="meshes/bar_tets.msh")", 5e-3});
   return cases;
@@ -206,7 +210,8 @@ TEST(InternalForces, PassThePatchTestUnderAHomogeneousDeformation) {
   Mat3 A;
   A << 1.05, 0.02, -0.03, -0.04, 0.97, 0.01, 0.02, 0.05, 1.08;
   const Vec3 b(0.3, -0.2, 0.1);
-  const std::vector<Vec3> forces = internalForces(scene, deformed(scene, [&](const Vec3& X) { return Vec3(A * X + b); }));
+  const std::vector<Vec3> forces =
+      internalForces(scene, deformed(scene, [&](const Vec3& X) { return Vec3(A * X + b); }));
 
   const Mat3 P = A * NeoHooke(LameParameters::fromYoung(kYoung, kPoisson)).stress(A.transpose() * A);
   std::vector<Vec3> expected(mesh.nodes.size(), Vec3::Zero());
@@ -306,10 +311,10 @@ TEST(ViscoelasticLBlock, EemKeepsEnergyPlusDissipationAndMomentaWhileEnergyDecay
     largestRise = std::max(largestRise, (h.energy[n] - h.energy[n - 1]) / h.energy[from]);
     largestFall = std::max(largestFall, (h.dissipated[n - 1] - h.dissipated[n]) / h.energy[from]);
   }
-  std::printf("viscoelastic L-block, EEM dt 0.25, t 5..20: drift of E + D %.2e, P %.2e, J %.2e; E fell to %.3f E(5); "
-              "largest step rise of E %.2e, fall of D %.2e\n",
-              drift.energy, drift.momentum, drift.angularMomentum, h.energy.back() / h.energy[from], largestRise,
-              largestFall);
+  std::printf(
+      "viscoelastic L-block, EEM dt 0.25, t 5..20: drift of E + D %.2e, P %.2e, J %.2e; E fell to %.3f E(5); "
+      "largest step rise of E %.2e, fall of D %.2e\n",
+      drift.energy, drift.momentum, drift.angularMomentum, h.energy.back() / h.energy[from], largestRise, largestFall);
   EXPECT_LE(drift.energy, 1e-9);
   EXPECT_LE(drift.momentum, 1e-9);
   EXPECT_LE(drift.angularMomentum, 1e-9);
@@ -363,10 +368,11 @@ TEST(ViscoelasticCantilever, ClampHoldsAndEnergyBalanceIsExactWhileItRelaxes) {
   const auto [error, scale] = loadedBalance(h);
   const double balanceError = error / scale;
   const double atLoadEnd = h.energy[indexAt(h, kLoadEnd)];
-  std::printf("cantilever, EEM dt 0.02 to t = 6: clamp moved %.2e; |E + D - W - E0| %.2e of %.3g; E(6) = %.3f peak, "
-              "%.3f E(5); W = %.3g, D = %.3g\n",
-              clampMotion, balanceError, scale, h.energy.back() / peak, h.energy.back() / atLoadEnd,
-              h.externalWork.back(), h.dissipated.back());
+  std::printf(
+      "cantilever, EEM dt 0.02 to t = 6: clamp moved %.2e; |E + D - W - E0| %.2e of %.3g; E(6) = %.3f peak, "
+      "%.3f E(5); W = %.3g, D = %.3g\n",
+      clampMotion, balanceError, scale, h.energy.back() / peak, h.energy.back() / atLoadEnd, h.externalWork.back(),
+      h.dissipated.back());
   EXPECT_LE(clampMotion, 1e-14);
   EXPECT_LE(balanceError, 1e-9);
   EXPECT_LT(h.energy.back(), atLoadEnd);  // relaxing once the pull stops
@@ -399,8 +405,8 @@ TEST(TetrahedralBar, IdaHoldsTheClampAndFollowsEem) {
   parameters.tEnd = 1.0;
   parameters.relativeTolerance = parameters.absoluteTolerance = 1e-8;
   std::vector<VectorXd> ida;
-  const RunSummary summary = runMethod(*scene.model, *methodByName("ida"), parameters,
-                                       [&](const StepRecord& r) { ida.push_back(*r.state); });
+  const RunSummary summary =
+      runMethod(*scene.model, *methodByName("ida"), parameters, [&](const StepRecord& r) { ida.push_back(*r.state); });
   ASSERT_FALSE(summary.failed) << summary.failure;
   const History eem = run(*scene.model, Scheme::Eem, 1e-3, 1.0, scene.settings.newton);
   const SolidPlacement& bar = scene.solids.front();
@@ -408,8 +414,9 @@ TEST(TetrahedralBar, IdaHoldsTheClampAndFollowsEem) {
   const int tip = bar.firstPositionDof + 3 * bar.mesh->nodesOf("right").front();
   const Vec3 idaTip = ida.back().segment<3>(tip), eemTip = eem.states.back().segment<3>(tip);
   const double deflection = (eemTip - bar.mesh->nodes[bar.mesh->nodesOf("right").front()]).norm();
-  std::printf("tet bar, IDA rtol 1e-8 to t = 1: clamp moved %.2e; |tip IDA - tip EEM(dt 1e-3)| = %.2e of deflection %.3f\n",
-              clampMotion, (idaTip - eemTip).norm(), deflection);
+  std::printf(
+      "tet bar, IDA rtol 1e-8 to t = 1: clamp moved %.2e; |tip IDA - tip EEM(dt 1e-3)| = %.2e of deflection %.3f\n",
+      clampMotion, (idaTip - eemTip).norm(), deflection);
   EXPECT_LE(clampMotion, 1e-12);
   EXPECT_LE((idaTip - eemTip).norm(), 1e-3 * deflection);
 }
@@ -433,9 +440,10 @@ TEST(StretchedBar, EndFaceFollowsThePrescribedDisplacementAndTheBalanceIsExact) 
   const double clampMotion = largestMotion(h.states, bar, "x0");
   const auto [error, scale] = loadedBalance(h);
   const double balanceError = error / scale;
-  std::printf("stretched bar, EEM dt 0.02 to t = 3: end face off its track by %.2e, clamp moved %.2e; "
-              "|E + D - W - E0| %.2e of %.3g; D = %.3g\n",
-              offTrack, clampMotion, balanceError, scale, h.dissipated.back());
+  std::printf(
+      "stretched bar, EEM dt 0.02 to t = 3: end face off its track by %.2e, clamp moved %.2e; "
+      "|E + D - W - E0| %.2e of %.3g; D = %.3g\n",
+      offTrack, clampMotion, balanceError, scale, h.dissipated.back());
   EXPECT_LE(offTrack, 1e-12);
   EXPECT_LE(clampMotion, 1e-14);
   EXPECT_LE(balanceError, 1e-9);
@@ -476,9 +484,10 @@ TEST(FlexiblePendulum, EnergyBalanceAndJointsHoldToRoundOff) {
   const SolidPlacement& link = r.scene.solids.front();
   const int tipY = link.firstPositionDof + 3 * link.mesh->nodesOf("x1").front() + 1;
   const double drop = h.states.front()[tipY] - h.states.back()[tipY];
-  std::printf("flexible pendulum, EEM dt 0.005 to t = 0.5: |E + D - E0| %.2e m g L, max constraint violation %.2e; "
-              "tip fell %.3f, D = %.3g\n",
-              balanceError, violation, drop, h.dissipated.back());
+  std::printf(
+      "flexible pendulum, EEM dt 0.005 to t = 0.5: |E + D - E0| %.2e m g L, max constraint violation %.2e; "
+      "tip fell %.3f, D = %.3g\n",
+      balanceError, violation, drop, h.dissipated.back());
   EXPECT_LE(balanceError, 1e-9);
   EXPECT_LE(violation, 1e-9);
   EXPECT_GT(drop, 0.1);
@@ -533,7 +542,8 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
     const double difference = (increment - plain).cwiseProduct(weight).cwiseAbs().maxCoeff() /
                               plain.cwiseProduct(weight).cwiseAbs().maxCoeff();
     const VectorXd defect = system.tangent() * increment + system.residual();
-    const double backwardError = defect.norm() / (system.residual().norm() + MatrixXd(system.tangent()).norm() * increment.norm());
+    const double backwardError =
+        defect.norm() / (system.residual().norm() + MatrixXd(system.tangent()).norm() * increment.norm());
     std::printf("%s, %s: condensed %d of %d unknowns, backward error %.2e, relative difference to plain LU %.2e\n",
                 GetParam(), schemeName(scheme).c_str(), condensed.condensedSize(), layout.total(), backwardError,
                 difference);

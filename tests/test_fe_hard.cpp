@@ -20,7 +20,8 @@ constexpr double kLoadEnd = 5.0;  // the L-block's tractions act for t <= 5
 // max |E_n - E(5)| / |E(5)| over the recorded steps from t = 5 on; infinite if the run never
 // got past the load.
 double energyDriftAfterLoad(const History& h) {
-  const auto from = static_cast<std::size_t>(std::lower_bound(h.time.begin(), h.time.end(), kLoadEnd - 1e-9) - h.time.begin());
+  const auto from =
+      static_cast<std::size_t>(std::lower_bound(h.time.begin(), h.time.end(), kLoadEnd - 1e-9) - h.time.begin());
   if (from >= h.energy.size()) return INFINITY;
   double drift = 0.0;
   for (std::size_t n = from; n < h.energy.size(); ++n)
@@ -70,10 +71,11 @@ TEST(NearlyIncompressibleLBlock, EemConvergesEveryStepAndKeepsTheEnergy) {
   const CompiledScene scene = lblockWith(R"(poisson="0.395469")", R"(poisson="0.495")");
   const History h = run(*scene.model, Scheme::Eem, 0.1, 10.0, scene.settings.newton);
   const double drift = energyDriftAfterLoad(h);
-  std::printf("L-block, Poisson 0.495, EEM dt 0.1 to t = 10: %d steps, %.2f Newton iterations per step, %d cut-backs; "
-              "E drift after the load %.2e\n",
-              h.summary.steps, static_cast<double>(h.summary.newtonIterations) / std::max(1, h.summary.steps),
-              h.summary.cutbacks, drift);
+  std::printf(
+      "L-block, Poisson 0.495, EEM dt 0.1 to t = 10: %d steps, %.2f Newton iterations per step, %d cut-backs; "
+      "E drift after the load %.2e\n",
+      h.summary.steps, static_cast<double>(h.summary.newtonIterations) / std::max(1, h.summary.steps),
+      h.summary.cutbacks, drift);
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
   EXPECT_EQ(h.summary.steps, 100);
   EXPECT_LE(drift, 1e-8);
@@ -85,11 +87,13 @@ TEST(RefinedLBlock, EemConservesEnergyAndMomentaAtLevelTwo) {
   const CompiledScene scene = lblockWith(R"(level="1")", R"(level="2")");
   const History h = run(*scene.model, Scheme::Eem, 0.1, 6.0, scene.settings.newton);
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  const auto from = static_cast<std::size_t>(std::lower_bound(h.time.begin(), h.time.end(), kLoadEnd - 1e-9) - h.time.begin());
+  const auto from =
+      static_cast<std::size_t>(std::lower_bound(h.time.begin(), h.time.end(), kLoadEnd - 1e-9) - h.time.begin());
   double momentum = 0.0, angular = 0.0;
   for (std::size_t n = from; n < h.time.size(); ++n) {
     momentum = std::max(momentum, h.momentum[n].norm());
-    angular = std::max(angular, (h.angularMomentum[n] - h.angularMomentum[from]).norm() / h.angularMomentum[from].norm());
+    angular =
+        std::max(angular, (h.angularMomentum[n] - h.angularMomentum[from]).norm() / h.angularMomentum[from].norm());
   }
   const double energy = energyDriftAfterLoad(h);
   std::printf("L-block level 2, EEM dt 0.1, t 5..6: drift of E %.2e, |P| %.2e, J %.2e\n", energy, momentum, angular);

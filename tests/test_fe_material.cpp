@@ -231,8 +231,8 @@ TEST_P(GonzalezStress, IncrementIsTheDerivativeInTheEndPoint) {
     double amplitude, step;
     bool belowSwitch;
   };
-  for (const Case& c : {Case{1.0, 1e-5, false}, Case{1e-2, 1e-5, false}, Case{1e-6, 1e-7, false},
-                        Case{1e-9, 1e-9, true}}) {
+  for (const Case& c :
+       {Case{1.0, 1e-5, false}, Case{1e-2, 1e-5, false}, Case{1e-6, 1e-7, false}, Case{1e-9, 1e-9, true}}) {
     const auto [C0, C1] = strainPair(random, c.amplitude);
     ASSERT_EQ((C1 - C0).norm() <= kStressQuotientSwitch * std::max(C0.norm(), C1.norm()), c.belowSwitch);
     const Mat3 H = random.symmetric();

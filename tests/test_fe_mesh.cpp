@@ -3,8 +3,8 @@
 // malformed file is rejected naming the file and line; VTK output parses as XML with the right sizes; the boundary
 // renders to a PNG.
 #include "engine/core/input_error.hpp"
-#include "models/scene/gmsh_reader.hpp"
 #include "models/fe/mesh_generators.hpp"
+#include "models/scene/gmsh_reader.hpp"
 #include "tools/output/surface_picture.hpp"
 #include "tools/output/vtk_writer.hpp"
 
@@ -102,8 +102,8 @@ void expectOutward(const Mesh& mesh, const std::vector<Face>& faces) {
                          [&](int n) { return std::find(c.nodes.begin(), end, n) != end; });
     });
     ASSERT_NE(cell, mesh.cells.end());
-    const Vec3 out = centroid(mesh, face.nodes.data(), face.count) -
-                     centroid(mesh, cell->nodes.data(), nodeCount(cell->type));
+    const Vec3 out =
+        centroid(mesh, face.nodes.data(), face.count) - centroid(mesh, cell->nodes.data(), nodeCount(cell->type));
     EXPECT_GT(areaVector(mesh, face).dot(out), 0);
   }
 }
@@ -382,9 +382,8 @@ $EndElements
 
 // A valid one-tet 2.2 file, line by line, for the malformed variants below.
 std::vector<std::string> tetLines() {
-  return {"$MeshFormat", "2.2 0 8",   "$EndMeshFormat", "$Nodes",          "4",
-          "1 0 0 0",     "2 1 0 0",   "3 0 1 0",        "4 0 0 1",         "$EndNodes",
-          "$Elements",   "1",         "1 4 2 1 1 1 2 3 4", "$EndElements"};
+  return {"$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$Nodes",    "4", "1 0 0 0",           "2 1 0 0",
+          "3 0 1 0",     "4 0 0 1", "$EndNodes",      "$Elements", "1", "1 4 2 1 1 1 2 3 4", "$EndElements"};
 }
 
 std::string joined(const std::vector<std::string>& lines) {
@@ -452,8 +451,9 @@ TEST(GmshReader, RejectsMalformedFormat41) {
                    "not a finite number");
   // an element block of an entity missing from $Entities
   expectInputError("entity41.msh",
-                   header + "$Entities\n0 0 0 0\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n"
-                            "0 1 0\n0 0 1\n$EndNodes\n$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n",
+                   header +
+                       "$Entities\n0 0 0 0\n$EndEntities\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n"
+                       "0 1 0\n0 0 1\n$EndNodes\n$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n",
                    21, "unknown entity 1");
 }
 

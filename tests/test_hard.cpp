@@ -24,8 +24,11 @@ struct Outcome {
 Outcome runCase(const std::string& scene, Scheme scheme, ThermalVariable variable, double dt, double tEnd) {
   const CompiledScene compiled = loadScene(scenePath(scene), variable);
   const History h = run(*compiled.model, scheme, dt, tEnd, compiled.settings.newton);
-  return {h.summary.failed, relativeBalanceDrift(h), h.summary.cutbacks,
-          h.summary.steps ? double(h.summary.newtonIterations) / h.summary.steps : 0.0, firstEntropyDecrease(h) < 0,
+  return {h.summary.failed,
+          relativeBalanceDrift(h),
+          h.summary.cutbacks,
+          h.summary.steps ? double(h.summary.newtonIterations) / h.summary.steps : 0.0,
+          firstEntropyDecrease(h) < 0,
           blewUp(h)};
 }
 
@@ -67,17 +70,16 @@ TEST_P(HardCases, EemStaysExactWhereStandardMethodsBlowUp) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    StiffAndLargeSteps, HardCases,
-    ::testing::Values(
-        // stiffness ratio 1e4, temperatures 0.5 to 5; stiff period 0.063
-        HardCase{"stiff_thermo_chain.xml", 50.0, {0.01, 0.05, 0.1, 0.25, 0.5, 1.0}, 0.1},
-        // steps up to beyond the fast period (about 2 pi) of the two thermo-spring system
-        HardCase{"two_thermo_springs.xml", 400.0, {0.5, 1.0, 2.0, 4.0, 8.0}, 2.0}),
-    [](const ::testing::TestParamInfo<HardCase>& info) {
-      const std::string scene = info.param.scene;
-      return scene.substr(0, scene.find('.'));
-    });
+INSTANTIATE_TEST_SUITE_P(StiffAndLargeSteps, HardCases,
+                         ::testing::Values(
+                             // stiffness ratio 1e4, temperatures 0.5 to 5; stiff period 0.063
+                             HardCase{"stiff_thermo_chain.xml", 50.0, {0.01, 0.05, 0.1, 0.25, 0.5, 1.0}, 0.1},
+                             // steps up to beyond the fast period (about 2 pi) of the two thermo-spring system
+                             HardCase{"two_thermo_springs.xml", 400.0, {0.5, 1.0, 2.0, 4.0, 8.0}, 2.0}),
+                         [](const ::testing::TestParamInfo<HardCase>& info) {
+                           const std::string scene = info.param.scene;
+                           return scene.substr(0, scene.find('.'));
+                         });
 
 }  // namespace
 }  // namespace mpx::test

@@ -26,8 +26,10 @@ std::string dampedPendulum(bool heatNode) {
     <joint name="elbow" type="revolute" a="link1" b="link2" anchor="1 0 0" axis="0 1 0"/>
     <reservoir name="bearing" heat_capacity="0.5" reference_temperature="300" temperature="300"/>
     <joint_force name="hinge_losses" joint="hinge" damping="0.2" friction="0.05" friction_velocity="0.01"
-                 branch_stiffness="3" viscosity="0.5")" + heat + R"(/>
-    <joint_force name="elbow_spring" joint="elbow" stiffness="5" rest="0.3" damping="0.1")" + heat + R"(/>
+                 branch_stiffness="3" viscosity="0.5")" +
+         heat + R"(/>
+    <joint_force name="elbow_spring" joint="elbow" stiffness="5" rest="0.3" damping="0.1")" +
+         heat + R"(/>
   </metriplex>)";
 }
 

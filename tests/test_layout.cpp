@@ -72,18 +72,17 @@ const std::string kWall = R"(<fixed_temperature name="wall" temperature="2"/>)";
 
 const Addition kAdditions[] = {
     {"thermo_spring", "", kThermoSpring, 1, 0, 1},
-    {"thermo_maxwell",
-     "",
+    {"thermo_maxwell", "",
      R"(<thermo_maxwell name="visco" a="m0" b="m1" stiffness="1" coupling="0.5" rest_length="1" heat_capacity="1"
                         reference_temperature="1" branch_stiffness="2" viscosity="1" temperature="1"/>)",
      1, 1, 1},
     {"reservoir", "", R"(<reservoir name="environment" heat_capacity="5" temperature="1"/>)", 1, 0, 1},
     {"maxwell", "",
-     R"(<maxwell name="branch" a="m0" b="m1" stiffness="1" rest_length="1" branch_stiffness="2" viscosity="1"/>)", 0,
-     1, 0},
+     R"(<maxwell name="branch" a="m0" b="m1" stiffness="1" rest_length="1" branch_stiffness="2" viscosity="1"/>)", 0, 1,
+     0},
     {"fixed_temperature", "", kWall, 0, 0, 1},
-    {"heat_link", kThermoSpring + kWall, R"(<heat_link name="conduction" a="hot" b="wall" conductivity="0.5"/>)", 0,
-     0, 0},
+    {"heat_link", kThermoSpring + kWall, R"(<heat_link name="conduction" a="hot" b="wall" conductivity="0.5"/>)", 0, 0,
+     0},
 };
 
 // Each element adds exactly its own dofs: thermo_spring and reservoir one thermal dof and node,
@@ -100,8 +99,7 @@ TEST(Layout, EachElementAddsExactlyItsOwnDofs) {
     EXPECT_EQ(blockSizes(with.model->layout()), expected) << addition.tag;
     EXPECT_EQ(with.model->thermalNodeNames().size(), without.model->thermalNodeNames().size() + addition.thermalNodes)
         << addition.tag;
-    EXPECT_EQ(with.model->layout().has(Block::Thermal), expected[static_cast<int>(Block::Thermal)] > 0)
-        << addition.tag;
+    EXPECT_EQ(with.model->layout().has(Block::Thermal), expected[static_cast<int>(Block::Thermal)] > 0) << addition.tag;
     EXPECT_EQ(with.model->layout().has(Block::Internal), expected[static_cast<int>(Block::Internal)] > 0)
         << addition.tag;
   }

@@ -115,13 +115,18 @@ TEST_P(RigidHardCases, EemStaysExactWhereMidpointFailsOrDrifts) {
 
 INSTANTIATE_TEST_SUITE_P(
     StiffPenalties, RigidHardCases,
-    ::testing::Values(
-        HardCase{"double_pendulum", [] { return penaltyVariant("double_pendulum_penalty.xml"); }, 2.0,
-                 {0.001, 0.005, 0.01, 0.05}, 0.001},
-        // at dt 0.001 the midpoint rule's error (about 11 %) is on the edge of "blown up"
-        HardCase{"flyball_governor", [] { return penaltyVariant("flyball_governor.xml"); }, 0.5,
-                 {0.001, 0.005, 0.01, 0.05}, 0.005},
-        HardCase{"whipping_chain", whippingChain, 1.0, {0.002, 0.01, 0.05}, 0.002}),
+    ::testing::Values(HardCase{"double_pendulum",
+                               [] { return penaltyVariant("double_pendulum_penalty.xml"); },
+                               2.0,
+                               {0.001, 0.005, 0.01, 0.05},
+                               0.001},
+                      // at dt 0.001 the midpoint rule's error (about 11 %) is on the edge of "blown up"
+                      HardCase{"flyball_governor",
+                               [] { return penaltyVariant("flyball_governor.xml"); },
+                               0.5,
+                               {0.001, 0.005, 0.01, 0.05},
+                               0.005},
+                      HardCase{"whipping_chain", whippingChain, 1.0, {0.002, 0.01, 0.05}, 0.002}),
     [](const ::testing::TestParamInfo<HardCase>& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -38,7 +38,8 @@ double energyDrift(const History& h) {
 // max_n max_i |v_n,i - v_0,i| / |v_0|: every component against the initial magnitude.
 double componentDrift(const std::vector<Vec3>& series) {
   double drift = 0.0;
-  for (const Vec3& v : series) drift = std::max(drift, (v - series.front()).cwiseAbs().maxCoeff() / series.front().norm());
+  for (const Vec3& v : series)
+    drift = std::max(drift, (v - series.front()).cwiseAbs().maxCoeff() / series.front().norm());
   return drift;
 }
 
@@ -124,13 +125,15 @@ const JointCase kJointCases[] = {
 std::string twoLinksJoinedBy(const JointCase& joint, const std::string& enforcement, double stiffness) {
   return R"(<metriplex name="two_links">
     <simulation dt="0.01" t_end="1"/>
-    <constraints enforcement=")" + enforcement + R"(" stiffness=")" + std::to_string(stiffness) + R"("/>
+    <constraints enforcement=")" +
+         enforcement + R"(" stiffness=")" + std::to_string(stiffness) + R"("/>
     <gravity g="1 -2 -9.81"/>
     <anchor name="ground" position="0 0 0"/>
     <body name="link1" mass="1" inertia="0.001667 0.08417 0.08417" position="0.5 0 0"/>
     <body name="link2" mass="1" inertia="0.001667 0.08417 0.08417" position="1.5 0 0"/>
     <joint name="hinge" type="revolute" a="ground" b="link1" anchor="0 0 0" axis="0 1 0"/>
-    <joint name="elbow" type=")" + joint.type + R"(" a="link1" b="link2" )" + joint.geometry + R"(/>
+    <joint name="elbow" type=")" +
+         joint.type + R"(" a="link1" b="link2" )" + joint.geometry + R"(/>
     </metriplex>)";
 }
 
@@ -152,8 +155,8 @@ TEST_P(JointEnforcement, AugmentedLagrangianHoldsEveryStep) {
 TEST_P(JointEnforcement, PenaltyViolationShrinksWithStiffness) {
   std::vector<double> largest;
   for (double stiffness : {1e4, 1e6, 1e8}) {
-    const SceneRun r =
-        runSteps(loadSceneText(twoLinksJoinedBy(GetParam(), "penalty", stiffness), GetParam().type), Scheme::Eem, kJointSteps);
+    const SceneRun r = runSteps(loadSceneText(twoLinksJoinedBy(GetParam(), "penalty", stiffness), GetParam().type),
+                                Scheme::Eem, kJointSteps);
     ASSERT_FALSE(r.history.summary.failed) << "stiffness " << stiffness << ": " << r.history.summary.failure;
     EXPECT_LE(energyDrift(r.history), kEnergyTolerance) << "stiffness " << stiffness;
     largest.push_back(maxViolation(*r.scene.model, r.history));
@@ -237,7 +240,8 @@ TEST(FreeRigidBody, TorqueDrivesTheAngularMomentum) {
 std::string everyJointType(const std::string& enforcement) {
   return R"(<metriplex name="every_joint">
     <simulation dt="0.1" t_end="1"/>
-    <constraints enforcement=")" + enforcement + R"(" stiffness="1e3"/>
+    <constraints enforcement=")" +
+         enforcement + R"(" stiffness="1e3"/>
     <gravity g="0.5 -1 -9.81"/>
     <anchor name="ground" position="0 0 0"/>
     <body name="b1" mass="1" inertia="0.01 0.09 0.09" position="0.5 0 0" angular_velocity="0 0.7 0.2"/>

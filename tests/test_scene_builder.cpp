@@ -24,10 +24,15 @@ SceneSpec twoThermoSpringsInCode() {
   scene.add("anchor", {{"name", "origin"}, {"position", Vec3(0, 0, 0)}});
   scene.add("mass", {{"name", "m1"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}, {"velocity", Vec3(0, 2, 0)}});
   scene.add("mass", {{"name", "m2"}, {"mass", 1.0}, {"position", Vec3(2.2, 0, 0)}, {"velocity", Vec3(1, 0, 0)}});
-  for (const auto& [name, a, b, entropy] :
-       {std::tuple{"s1", "origin", "m1", 1.0}, std::tuple{"s2", "m1", "m2", 0.2}})
-    scene.add("thermo_spring", {{"name", name}, {"a", a}, {"b", b}, {"stiffness", 1.0}, {"coupling", 1.0},
-                                {"rest_length", 1.0}, {"heat_capacity", 1.0}, {"reference_temperature", 1.0},
+  for (const auto& [name, a, b, entropy] : {std::tuple{"s1", "origin", "m1", 1.0}, std::tuple{"s2", "m1", "m2", 0.2}})
+    scene.add("thermo_spring", {{"name", name},
+                                {"a", a},
+                                {"b", b},
+                                {"stiffness", 1.0},
+                                {"coupling", 1.0},
+                                {"rest_length", 1.0},
+                                {"heat_capacity", 1.0},
+                                {"reference_temperature", 1.0},
                                 {"entropy", entropy}});
   scene.add("heat_link", {{"name", "h12"}, {"a", "s1"}, {"b", "s2"}, {"conductivity", 1.0}});
   return scene;

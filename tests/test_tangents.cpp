@@ -197,8 +197,7 @@ INSTANTIATE_TEST_SUITE_P(AllElements, StepTangent, testing::ValuesIn(stepCases()
                          [](const testing::TestParamInfo<StepCase>& info) {
                            const StepCase& c = info.param;
                            return std::string(c.scene->name) + "_" + variableName(c.variable) + "_" +
-                                  schemeName(c.scheme) +
-                                  (c.form == DiscreteGradientForm::Gonzalez ? "_gonzalez" : "");
+                                  schemeName(c.scheme) + (c.form == DiscreteGradientForm::Gonzalez ? "_gonzalez" : "");
                          });
 
 // The rate form F(t, z, zdot) of every component, assembled densely in the model's order (heat

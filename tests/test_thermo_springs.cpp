@@ -10,7 +10,7 @@
 namespace mpx::test {
 namespace {
 
-constexpr double kStep = 0.2;     // the scene's step: about 1/30 of the fast period
+constexpr double kStep = 0.2;      // the scene's step: about 1/30 of the fast period
 constexpr double kEndTime = 2000;  // 10^4 steps
 
 double maxRelativeDrift(const std::vector<double>& series) {

@@ -114,7 +114,8 @@ const std::vector<LinkData> kLinks = {
     {"plate", 0.5, {0.0, 0.0, -0.02}, {0, 0, 0}, 0.003, 0.003, 0.005, 0, 0, 0},
     {"drone", 0.9, {0.0, 0.0, 0.0}, {0, 0, 0}, 0.01, 0.01, 0.018, 0, 0, 0},
 };
-const std::vector<JointData> kJoints = {  // parents before children
+const std::vector<JointData> kJoints = {
+    // parents before children
     {"shoulder", "revolute", "base", "upper", {0, 0, 0.3}, {0, 0, 0.4}, {0, 1, 1}, 0.5, 1.3},
     {"slide", "prismatic", "upper", "slider", {0.4, 0, 0}, {0.3, 0, 0}, {1, 0, 0}, 0.05, -0.4},
     {"mount_joint", "fixed", "slider", "mount", {0, 0.1, 0}, {0, 0.5, 0}, {1, 0, 0}, 0, 0},
@@ -148,8 +149,7 @@ std::string robotText() {
     text += "  <joint name=\"" + j.name + "\" type=\"" + j.type + "\"><parent link=\"" + j.parent +
             "\"/><child link=\"" + j.child + "\"/><origin xyz=\"" + numbers(j.xyz) + "\" rpy=\"" + numbers(j.rpy) +
             "\"/><axis xyz=\"" + numbers(j.axis) + "\"/>" +
-            (j.type == "revolute" || j.type == "prismatic" ? kLimit : "") +
-            "</joint>\n";
+            (j.type == "revolute" || j.type == "prismatic" ? kLimit : "") + "</joint>\n";
   return text + "</robot>\n";
 }
 
@@ -158,7 +158,8 @@ Pose originPose(const Vec3& xyz, const Vec3& rpy) {
   Pose pose = Pose::Identity();
   pose.translation() = xyz;
   pose.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                   Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())).toRotationMatrix();
+                   Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+                      .toRotationMatrix();
   return pose;
 }
 
@@ -200,9 +201,10 @@ double kineticEnergy() {
 TEST_F(UrdfTest, InitialKineticEnergyAndPositionsMatchIndependentKinematics) {
   write("robot.urdf", robotText());
   const Eigen::Quaterniond& q = kRootOrientation;
-  std::string scene = "<metriplex name=\"kinetic\">\n  <simulation dt=\"0.01\" t_end=\"1\"/>\n"
-                      "  <urdf file=\"robot.urdf\" position=\"" + numbers(kRootPosition) + "\" orientation=\"" +
-                      numbers({q.w(), q.x(), q.y(), q.z()}) + "\">\n";
+  std::string scene =
+      "<metriplex name=\"kinetic\">\n  <simulation dt=\"0.01\" t_end=\"1\"/>\n"
+      "  <urdf file=\"robot.urdf\" position=\"" +
+      numbers(kRootPosition) + "\" orientation=\"" + numbers({q.w(), q.x(), q.y(), q.z()}) + "\">\n";
   for (const JointData& j : kJoints)
     if (hasCoordinate(j))
       scene += "    <initial joint=\"" + j.name + "\" position=\"" + numbers({j.position}) + "\" velocity=\"" +
@@ -233,8 +235,9 @@ TEST_F(UrdfTest, PendulumPeriodMatchesTheCompoundPendulum) {
   const double iyy = m / 12 * (width * width + length * length), izz = m / 6 * width * width;
   write("pendulum.urdf",
         "<robot name=\"pendulum\">\n  <link name=\"world\"/>\n"
-        "  <link name=\"rod\"><inertial><origin xyz=\"0 0 " + numbers({-d}) + "\"/><mass value=\"" + numbers({m}) +
-            "\"/><inertia ixx=\"" + numbers({iyy}) + "\" iyy=\"" + numbers({iyy}) + "\" izz=\"" + numbers({izz}) +
+        "  <link name=\"rod\"><inertial><origin xyz=\"0 0 " +
+            numbers({-d}) + "\"/><mass value=\"" + numbers({m}) + "\"/><inertia ixx=\"" + numbers({iyy}) + "\" iyy=\"" +
+            numbers({iyy}) + "\" izz=\"" + numbers({izz}) +
             "\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n"
             "  <joint name=\"hinge\" type=\"continuous\"><parent link=\"world\"/><child link=\"rod\"/>"
             "<axis xyz=\"0 1 0\"/></joint>\n</robot>\n");
@@ -287,9 +290,9 @@ std::string jointWith(const std::string& name, const std::string& type, const st
          "\"/>" + inside + "</joint>";
 }
 
-const std::string kWorld = "<link name=\"world\"/>";                     // line 2
+const std::string kWorld = "<link name=\"world\"/>";  // line 2
 const std::string kBox = "ixx=\"0.02\" iyy=\"0.02\" izz=\"0.001\"";
-const std::string kArm = linkWith("arm", "1", kBox);                     // line 3
+const std::string kArm = linkWith("arm", "1", kBox);  // line 3
 const std::string kHinge = jointWith("hinge", "continuous", "world", "arm");
 const std::string kValidRobot = robotWith({kWorld, kArm, kHinge});
 
@@ -306,41 +309,64 @@ std::ostream& operator<<(std::ostream& os, const BadUrdf& c) { return os << c.la
 
 const std::vector<BadUrdf> kBadUrdfs = {
     {"MalformedXml", "<robot name=\"bad\">\n  <link name=\"world\">\n</robot>\n", 2, {"malformed XML", "link"}},
-    {"RevoluteWithoutLimits", robotWith({kWorld, kArm, jointWith("hinge", "revolute", "world", "arm")}), 0,
+    {"RevoluteWithoutLimits",
+     robotWith({kWorld, kArm, jointWith("hinge", "revolute", "world", "arm")}),
+     0,
      {"invalid URDF", "[hinge]", "limits"}},
-    {"UnparsableMass", robotWith({kWorld, linkWith("arm", "heavy", kBox), kHinge}), 0,
+    {"UnparsableMass",
+     robotWith({kWorld, linkWith("arm", "heavy", kBox), kHinge}),
+     0,
      {"invalid URDF", "[heavy]", "[arm]"}},
-    {"MissingLink", robotWith({kWorld, kArm, kHinge, jointWith("wrist", "continuous", "arm", "hand")}), 0,
+    {"MissingLink",
+     robotWith({kWorld, kArm, kHinge, jointWith("wrist", "continuous", "arm", "hand")}),
+     0,
      {"invalid URDF", "[hand]", "[wrist]"}},
-    {"TwoRoots", robotWith({kWorld, kArm, linkWith("loose", "1", kBox), kHinge}), 0,
+    {"TwoRoots",
+     robotWith({kWorld, kArm, linkWith("loose", "1", kBox), kHinge}),
+     0,
      {"invalid URDF", "Two root links", "[loose]"}},
     {"CycleAwayFromTheRoot",
      robotWith({kWorld, kArm, linkWith("a", "1", kBox), linkWith("b", "1", kBox), kHinge,
                 jointWith("ab", "continuous", "a", "b"), jointWith("ba", "continuous", "b", "a")}),
-     4, {"<link name=\"a\">", "not connected to the root link 'world'"}},
+     4,
+     {"<link name=\"a\">", "not connected to the root link 'world'"}},
     {"LinkWithTwoParents",
      robotWith({kWorld, kArm, linkWith("b", "1", kBox), kHinge, jointWith("world_b", "continuous", "world", "b"),
                 jointWith("arm_b", "continuous", "arm", "b")}),
-     4, {"<link name=\"b\">", "child of two joints", "'world_b'", "'arm_b'"}},
-    {"NegativeMass", robotWith({kWorld, linkWith("arm", "-1", kBox), kHinge}), 3,
+     4,
+     {"<link name=\"b\">", "child of two joints", "'world_b'", "'arm_b'"}},
+    {"NegativeMass",
+     robotWith({kWorld, linkWith("arm", "-1", kBox), kHinge}),
+     3,
      {"<link name=\"arm\">", "mass must be positive"}},
-    {"ZeroMassMovingLink", robotWith({kWorld, "<link name=\"arm\"/>", kHinge}), 3,
+    {"ZeroMassMovingLink",
+     robotWith({kWorld, "<link name=\"arm\"/>", kHinge}),
+     3,
      {"<link name=\"arm\">", "has no mass", "'hinge'"}},
-    {"ZeroMassWithInertia", robotWith({kWorld, linkWith("arm", "0", kBox), kHinge}), 3,
+    {"ZeroMassWithInertia",
+     robotWith({kWorld, linkWith("arm", "0", kBox), kHinge}),
+     3,
      {"<link name=\"arm\">", "mass must be positive"}},
     {"IndefiniteInertia",
-     robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.02\" iyy=\"-0.02\" izz=\"0.001\""), kHinge}), 3,
+     robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.02\" iyy=\"-0.02\" izz=\"0.001\""), kHinge}),
+     3,
      {"<link name=\"arm\">", "positive definite"}},
-    {"FlatInertia", robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.01\" iyy=\"0.01\" izz=\"0.03\""), kHinge}), 3,
+    {"FlatInertia",
+     robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.01\" iyy=\"0.01\" izz=\"0.03\""), kHinge}),
+     3,
      {"<link name=\"arm\">", "triangle inequality"}},
     {"Mimic",
      robotWith({kWorld, kArm, linkWith("hand", "1", kBox), kHinge,
                 jointWith("wrist", "continuous", "arm", "hand", "<axis xyz=\"0 1 0\"/><mimic joint=\"hinge\"/>")}),
-     6, {"<joint name=\"wrist\">", "mimic"}},
-    {"JointNamedLikeALink", robotWith({kWorld, kArm, jointWith("arm", "continuous", "world", "arm")}), 4,
+     6,
+     {"<joint name=\"wrist\">", "mimic"}},
+    {"JointNamedLikeALink",
+     robotWith({kWorld, kArm, jointWith("arm", "continuous", "world", "arm")}),
+     4,
      {"<joint name=\"arm\">", "name of a link"}},
     {"ZeroAxis",
-     robotWith({kWorld, kArm, jointWith("hinge", "continuous", "world", "arm", "<axis xyz=\"0 0 0\"/>")}), 4,
+     robotWith({kWorld, kArm, jointWith("hinge", "continuous", "world", "arm", "<axis xyz=\"0 0 0\"/>")}),
+     4,
      {"<joint name=\"hinge\">", "<axis>"}},
 };
 
@@ -372,18 +398,27 @@ struct BadInclude {
 std::ostream& operator<<(std::ostream& os, const BadInclude& c) { return os << c.label; }
 
 const std::vector<BadInclude> kBadIncludes = {
-    {"InvalidUrdfNamesBothFiles", robotWith({kWorld, linkWith("arm", "-1", kBox), kHinge}),
-     "<urdf file=\"robot.urdf\"/>", {"<urdf>", "robot.urdf:3:", "<link name=\"arm\">", "mass must be positive"}},
+    {"InvalidUrdfNamesBothFiles",
+     robotWith({kWorld, linkWith("arm", "-1", kBox), kHinge}),
+     "<urdf file=\"robot.urdf\"/>",
+     {"<urdf>", "robot.urdf:3:", "<link name=\"arm\">", "mass must be positive"}},
     {"MissingUrdfFile", kValidRobot, "<urdf file=\"no_such.urdf\"/>", {"<urdf>", "no_such.urdf", "cannot open"}},
-    {"UnknownInitialJoint", kValidRobot, "<urdf file=\"robot.urdf\"><initial joint=\"elbow\" position=\"1\"/></urdf>",
+    {"UnknownInitialJoint",
+     kValidRobot,
+     "<urdf file=\"robot.urdf\"><initial joint=\"elbow\" position=\"1\"/></urdf>",
      {"<urdf>", "'elbow'", "does not have"}},
-    {"InitialOnFixedJoint", robotWith({kWorld, kArm, jointWith("weld", "fixed", "world", "arm", "")}),
+    {"InitialOnFixedJoint",
+     robotWith({kWorld, kArm, jointWith("weld", "fixed", "world", "arm", "")}),
      "<urdf file=\"robot.urdf\"><initial joint=\"weld\" position=\"1\"/></urdf>",
      {"<urdf>", "<joint name=\"weld\">", "no initial position"}},
-    {"FloatingMasslessRoot", kValidRobot, "<urdf file=\"robot.urdf\" floating=\"true\"/>",
+    {"FloatingMasslessRoot",
+     kValidRobot,
+     "<urdf file=\"robot.urdf\" floating=\"true\"/>",
      {"<urdf>", "<link name=\"world\">", "floating root"}},
     {"BadFlag", kValidRobot, "<urdf file=\"robot.urdf\" floating=\"yes\"/>", {"<urdf>", "'floating'", "'yes'"}},
-    {"NameClash", kValidRobot, "<urdf file=\"robot.urdf\"/>\n  <mass name=\"arm\" mass=\"1\"/>",
+    {"NameClash",
+     kValidRobot,
+     "<urdf file=\"robot.urdf\"/>\n  <mass name=\"arm\" mass=\"1\"/>",
      {"<urdf>", "'arm'", "line 6", "prefix"}},
 };
 
@@ -392,9 +427,11 @@ class BadIncludeTest : public UrdfTest, public ::testing::WithParamInterface<Bad
 TEST_P(BadIncludeTest, RunExitsTwoAtTheUrdfElement) {
   const BadInclude& c = GetParam();
   write("robot.urdf", c.urdf);
-  const fs::path scene = write("scene.xml", "<?xml version=\"1.0\"?>\n<metriplex name=\"include\">\n"
-                                            "  <simulation dt=\"0.01\" t_end=\"0.1\"/>\n"
-                                            "  <anchor name=\"pivot\"/>\n  " + c.elements + "\n</metriplex>\n");
+  const fs::path scene = write("scene.xml",
+                               "<?xml version=\"1.0\"?>\n<metriplex name=\"include\">\n"
+                               "  <simulation dt=\"0.01\" t_end=\"0.1\"/>\n"
+                               "  <anchor name=\"pivot\"/>\n  " +
+                                   c.elements + "\n</metriplex>\n");
   const auto [code, err] = metriplex("run " + quoted(scene) + " --out " + quoted(dir_ / "out"));
   EXPECT_EQ(code, kExitInvalidInput) << err;
   EXPECT_NE(err.find(scene.string() + ":5:"), std::string::npos) << err;
@@ -415,8 +452,9 @@ TEST(PlanarJoint, LeavesExactlyTheInPlaneMotionFree) {
   const CompiledScene compiled = loadSceneText(
       "<metriplex name=\"planar\">\n  <simulation dt=\"0.01\" t_end=\"2\"/>\n  <gravity g=\"0 0 -9.81\"/>\n"
       "  <anchor name=\"ground\"/>\n"
-      "  <body name=\"puck\" mass=\"2\" inertia=\"0.01 0.012 0.02\" position=\"" + numbers(start) + "\" velocity=\"" +
-          numbers(velocity) + "\" angular_velocity=\"0 0 " + numbers({spin}) + "\"/>\n"
+      "  <body name=\"puck\" mass=\"2\" inertia=\"0.01 0.012 0.02\" position=\"" +
+          numbers(start) + "\" velocity=\"" + numbers(velocity) + "\" angular_velocity=\"0 0 " + numbers({spin}) +
+          "\"/>\n"
           "  <joint name=\"table\" type=\"planar\" a=\"ground\" b=\"puck\" anchor=\"0 0 1\" axis=\"0 0 1\"/>\n"
           "</metriplex>\n",
       "planar-test");
@@ -455,8 +493,8 @@ TEST(UrdfScenes, DampedArmBalancesEnergyAndDissipation) {
   const double dt = compiled.settings.dt;
   const History h = run(*compiled.model, Scheme::Eem, dt, 200 * dt, compiled.settings.newton);
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  std::printf("damped_robot_arm: 200 EEM steps, dissipated %.6f J, max |E + D - E0|/|E0| = %.3e\n",
-              h.dissipated.back(), h.summary.maxEnergyBalanceError);
+  std::printf("damped_robot_arm: 200 EEM steps, dissipated %.6f J, max |E + D - E0|/|E0| = %.3e\n", h.dissipated.back(),
+              h.summary.maxEnergyBalanceError);
   EXPECT_GT(h.dissipated.back(), 0.01 * std::abs(h.energy.front()));  // the URDF damping acts
   EXPECT_LT(h.summary.maxEnergyBalanceError, 1e-10);
 }

@@ -80,7 +80,8 @@ BenchRun measure(const Model& model, const Method& method, const MethodParameter
       if (m.entropy < previousEntropy - 1e-14 * std::abs(m.entropy)) ++run.entropyViolations;
       previousEntropy = m.entropy;
       if (keepSeries) {
-        const double error = balance.relativeError(m.energy, record.crossed.dissipated, record.crossed.externalWork, record.crossed.boundaryHeat);
+        const double error = balance.relativeError(m.energy, record.crossed.dissipated, record.crossed.externalWork,
+                                                   record.crossed.boundaryHeat);
         run.series.push_back({record.time, error, m.entropy - initialEntropy});
       }
       last = m;
@@ -122,7 +123,8 @@ FinalState reference(const Model& model, const std::string& sceneText, double tE
   parameters.relativeTolerance = kReferenceTolerance;
   parameters.absoluteTolerance = kReferenceTolerance;
   const BenchRun run = measure(model, *methodByName("ida"), parameters, 1, false);
-  if (run.summary.failed) throw std::runtime_error("the reference run (IDA, rtol 1e-12) failed: " + run.summary.failure);
+  if (run.summary.failed)
+    throw std::runtime_error("the reference run (IDA, rtol 1e-12) failed: " + run.summary.failure);
   auto out = fmt::output_file(file.string());
   out.print("# {}\n", key);
   std::string row;
@@ -163,7 +165,8 @@ int benchCommand(const BenchRequest& request) {
   // validate everything before anything is written
   if (request.repeats < 1) throw InputError("option --repeats must be at least 1");
   for (double v : request.steps)
-    if (!(v > 0.0 && std::isfinite(v))) throw InputError(fmt::format("option --dts: steps must be positive, got {}", v));
+    if (!(v > 0.0 && std::isfinite(v)))
+      throw InputError(fmt::format("option --dts: steps must be positive, got {}", v));
   for (double v : request.tolerances)
     if (!(v > 0.0 && v < 1.0)) throw InputError(fmt::format("option --rtols: tolerances must be in (0, 1), got {}", v));
   if (request.tEnd && !(*request.tEnd > 0.0)) throw InputError("option --t-end must be positive");
@@ -175,8 +178,7 @@ int benchCommand(const BenchRequest& request) {
   }
   const std::string sceneText = readFile(request.scene);
   std::map<std::string, CompiledScene> scenes;  // per method name: its thermal variable
-  for (const Method& method : methods)
-    scenes.emplace(method.name, loadScene(request.scene, method.thermalVariable));
+  for (const Method& method : methods) scenes.emplace(method.name, loadScene(request.scene, method.thermalVariable));
   const CompiledScene own = loadScene(request.scene);
   checkMethodSupports(*methodByName("ida"), *own.model, request.scene);  // the reference is an IDA run
   const SceneSettings& settings = own.settings;
@@ -194,7 +196,8 @@ int benchCommand(const BenchRequest& request) {
 
   // representative runs for the time series: the scene's step, rtol 1e-6 (or the middle ones)
   const double seriesStep = std::count(steps.begin(), steps.end(), settings.dt) ? settings.dt : steps[steps.size() / 2];
-  const double seriesTolerance = std::count(tolerances.begin(), tolerances.end(), 1e-6) ? 1e-6 : tolerances[tolerances.size() / 2];
+  const double seriesTolerance =
+      std::count(tolerances.begin(), tolerances.end(), 1e-6) ? 1e-6 : tolerances[tolerances.size() / 2];
   std::vector<BenchRun> runs;
   for (const Method& method : methods) {
     const Model& model = *scenes.at(method.name).model;
@@ -209,9 +212,9 @@ int benchCommand(const BenchRequest& request) {
       BenchRun run = measure(model, method, parameters, request.repeats, keepSeries);
       (method.isIda() ? run.rtol : run.dt) = value;
       run.error = run.summary.failed ? INFINITY : relativeError(run.final, referenceState);
-      run.status = run.summary.failed ? "failed"
+      run.status = run.summary.failed                                                                ? "failed"
                    : !(run.summary.maxEnergyBalanceError < kBlowUpEnergyError) || !(run.error < 1.0) ? "blew-up"
-                                                                                                       : "ok";
+                                                                                                     : "ok";
       fmt::print("{:<16} {:>10} {:>10.4g} s CPU  error {:.3e}  energy drift {:.3e}  {}\n", method.name,
                  fmt::format(method.isIda() ? "rtol {:g}" : "dt {:g}", value), run.cpuSeconds, run.error,
                  run.summary.maxEnergyBalanceError, run.status);
@@ -230,8 +233,9 @@ int benchCommand(const BenchRequest& request) {
     workPrecision.push_back(std::move(curve));
     for (const BenchRun& r : runs)
       if (r.integrator == method.name && !r.series.empty())
-        series.push_back({fmt::format(method.isIda() ? "{} rtol {:g}" : "{} dt {:g}", method.name, method.isIda() ? r.rtol : r.dt),
-                          r.series});
+        series.push_back(
+            {fmt::format(method.isIda() ? "{} rtol {:g}" : "{} dt {:g}", method.name, method.isIda() ? r.rtol : r.dt),
+             r.series});
   }
   renderPlots(out, own.name, tEnd, workPrecision, series);
   fmt::print("wrote {}/work_precision.csv, work_precision.png, energy_error.png, entropy.png\n", out.string());

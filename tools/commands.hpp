@@ -14,7 +14,7 @@ struct RunRequest {
   std::string scene;
   std::string integrator;  // empty: the scene's default
   std::optional<double> dt, tEnd;
-  std::string out;  // empty: a directory under out/ named after the scene
+  std::string out;                      // empty: a directory under out/ named after the scene
   std::optional<double> frameInterval;  // bodies.csv and joints.csv rows; empty: every step
   // IDA only
   double relativeTolerance = 1e-6, absoluteTolerance = 1e-8;

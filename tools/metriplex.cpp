@@ -4,8 +4,8 @@
 
 #include "engine/core/input_error.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <filesystem>
 #include <sstream>
@@ -23,16 +23,18 @@ std::vector<std::string> splitNames(const std::string& list) {
 
 // Options every subcommand shares.
 void addSceneOptions(CLI::App* command, RunRequest& request) {
-  command->add_option("SCENE", request.scene, "scene file (XML) or a robot's .urdf, see docs/scene-format.md")->required();
+  command->add_option("SCENE", request.scene, "scene file (XML) or a robot's .urdf, see docs/scene-format.md")
+      ->required();
   command->add_option("--t-end", request.tEnd, "end time (default: the scene's simulation t_end)");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Metriplex: flexible multibody dynamics with dissipation, integrated with "
-               "Energy-Entropy-Momentum (EEM) and standard methods.\n"
-               "Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure."};
+  CLI::App app{
+      "Metriplex: flexible multibody dynamics with dissipation, integrated with "
+      "Energy-Entropy-Momentum (EEM) and standard methods.\n"
+      "Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure."};
   app.require_subcommand(1);
 
   RunRequest request;
@@ -52,8 +54,9 @@ int main(int argc, char** argv) {
   run->add_option("--output-interval", request.frameInterval,
                   "interval of bodies.csv and joints.csv rows and of solid frames (.vtu) (default: every history row)");
 
-  CLI::App* compare = app.add_subcommand("compare", "run one scene with several integrators and tabulate "
-                                                    "energy drift, entropy and cost side by side");
+  CLI::App* compare = app.add_subcommand("compare",
+                                         "run one scene with several integrators and tabulate "
+                                         "energy drift, entropy and cost side by side");
   addSceneOptions(compare, request);
   compare->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   compare->add_option("--integrators", integrators, "comma-separated integrators")->capture_default_str();
@@ -61,13 +64,14 @@ int main(int argc, char** argv) {
 
   BenchRequest bench;
   std::string benchIntegrators = "eem,midpoint,trapezoidal,ida";
-  CLI::App* benchCommandLine = app.add_subcommand(
-      "bench", "work-precision sweep: one-step integrators over steps, IDA over tolerances, against a cached "
-               "reference (IDA, rtol 1e-12); writes work_precision.csv and PNG plots");
+  CLI::App* benchCommandLine =
+      app.add_subcommand("bench",
+                         "work-precision sweep: one-step integrators over steps, IDA over tolerances, against a cached "
+                         "reference (IDA, rtol 1e-12); writes work_precision.csv and PNG plots");
   addSceneOptions(benchCommandLine, request);
-  benchCommandLine->add_option("--integrators", benchIntegrators, "comma-separated integrators")
-      ->capture_default_str();
-  benchCommandLine->add_option("--dts", bench.steps, "steps of the one-step integrators (default: scene dt x 2 .. 1/16)")
+  benchCommandLine->add_option("--integrators", benchIntegrators, "comma-separated integrators")->capture_default_str();
+  benchCommandLine
+      ->add_option("--dts", bench.steps, "steps of the one-step integrators (default: scene dt x 2 .. 1/16)")
       ->delimiter(',');
   benchCommandLine->add_option("--rtols", bench.tolerances, "IDA relative tolerances (default: 1e-3 .. 1e-10)")
       ->delimiter(',');

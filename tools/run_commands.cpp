@@ -77,9 +77,8 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.absoluteTolerance = request.absoluteTolerance;
   parameters.maxOrder = request.maxOrder;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
-  std::filesystem::path out = request.out.empty()
-                                  ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
-                                  : std::filesystem::path(request.out);
+  std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
+                                                  : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
   return {*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
 }
@@ -89,15 +88,16 @@ RunResult execute(const PreparedRun& run) {
   HistoryCsv history(run.out, *run.scene.model);
   FramesCsv frames(run.out, run.scene, run.frameInterval);
   SolidFrames solids(run.out, run.scene, run.frameInterval);
-  RunResult result{run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {},
-                   history.path()};
-  result.summary = runMethod(*run.scene.model, run.method, run.parameters,
-                             [&](const StepRecord& r) {
-                               history.write(r);
-                               frames.write(r);
-                               solids.write(r);
-                             },
-                             progressBar(run.scene.name + " " + run.method.name));
+  RunResult result{
+      run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {}, history.path()};
+  result.summary = runMethod(
+      *run.scene.model, run.method, run.parameters,
+      [&](const StepRecord& r) {
+        history.write(r);
+        frames.write(r);
+        solids.write(r);
+      },
+      progressBar(run.scene.name + " " + run.method.name));
   history.finish(result.summary);
   frames.finish();
   solids.finish();
@@ -110,19 +110,22 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
   const RunSummary& s = r.summary;
   fmt::print("metriplex run {} --integrator {} (thermal variable: {})\n", request.scene, method.name, r.variable);
   fmt::print("  steps                    {}{}\n", s.steps, s.ida ? " (output times)" : "");
-  fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations, perStep(s.newtonIterations, s.steps));
+  fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations,
+             perStep(s.newtonIterations, s.steps));
   if (s.ida)
-    fmt::print("  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
-               "{} nonlinear iterations, {} error-test failures\n",
-               s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
-               s.ida->errorTestFailures);
+    fmt::print(
+        "  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
+        "{} nonlinear iterations, {} error-test failures\n",
+        s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
+        s.ida->errorTestFailures);
   else {
     fmt::print("  cut-backs                {}\n", s.cutbacks);
     fmt::print("  linear system            {}\n", s.linearSystem);
   }
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
-  fmt::print("  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
-             s.maxEnergyBalanceError);
+  fmt::print(
+      "  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
+      s.maxEnergyBalanceError);
   fmt::print("  min entropy increment    {:.3e}\n", s.minEntropyIncrement);
   fmt::print("  history                  {}\n", r.history.string());
 }
@@ -134,7 +137,8 @@ int runCommand(const RunRequest& request) {
   const RunResult result = execute(run);
   printSummary(result, request, run.method);
   if (!result.summary.failed) return 0;
-  fmt::print(stderr, "metriplex: solver failure at step {} (t = {:.9g}): {}; history kept up to the last good step in {}\n",
+  fmt::print(stderr,
+             "metriplex: solver failure at step {} (t = {:.9g}): {}; history kept up to the last good step in {}\n",
              result.summary.failedStep, result.summary.failedTime, result.summary.failure, result.history.string());
   return kExitSolverFailure;
 }

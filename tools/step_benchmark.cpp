@@ -15,8 +15,8 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
-#include <tuple>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace {
@@ -57,13 +57,23 @@ SceneSpec thermoSpringChain(int masses, double dt) {
   const auto point = [](int i) { return i == 0 ? std::string("origin") : "m" + std::to_string(i); };
   for (int i = 1; i <= masses; ++i) {
     const std::string spring = "s" + std::to_string(i);
-    scene.add("mass", {{"name", point(i)}, {"mass", 1.0}, {"position", Vec3(1.1 * i, 0, 0)},
+    scene.add("mass", {{"name", point(i)},
+                       {"mass", 1.0},
+                       {"position", Vec3(1.1 * i, 0, 0)},
                        {"velocity", Vec3(0, 0.2 * std::sin(0.3 * i), 0.1 * std::cos(0.7 * i))}});
-    scene.add("thermo_spring", {{"name", spring}, {"a", point(i - 1)}, {"b", point(i)}, {"stiffness", 1.0},
-                                {"coupling", 1.0}, {"rest_length", 1.0}, {"heat_capacity", 1.0},
-                                {"reference_temperature", 1.0}, {"temperature", 1.0 + 0.5 * std::sin(i)}});
+    scene.add("thermo_spring", {{"name", spring},
+                                {"a", point(i - 1)},
+                                {"b", point(i)},
+                                {"stiffness", 1.0},
+                                {"coupling", 1.0},
+                                {"rest_length", 1.0},
+                                {"heat_capacity", 1.0},
+                                {"reference_temperature", 1.0},
+                                {"temperature", 1.0 + 0.5 * std::sin(i)}});
     if (i > 1)
-      scene.add("heat_link", {{"name", "h" + std::to_string(i)}, {"a", "s" + std::to_string(i - 1)}, {"b", spring},
+      scene.add("heat_link", {{"name", "h" + std::to_string(i)},
+                              {"a", "s" + std::to_string(i - 1)},
+                              {"b", spring},
                               {"conductivity", 1.0}});
   }
   return scene;
@@ -83,10 +93,16 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
   scene.add("anchor", {{"name", "origin"}, {"position", Vec3::Zero()}});
   const auto link = [](int i) { return i < 0 ? std::string("origin") : "l" + std::to_string(i); };
   for (int i = 0; i < links; ++i) {
-    scene.add("body", {{"name", link(i)}, {"mass", mass}, {"inertia", Vec3(axial, transverse, transverse)},
+    scene.add("body", {{"name", link(i)},
+                       {"mass", mass},
+                       {"inertia", Vec3(axial, transverse, transverse)},
                        {"position", Vec3(length * (i + 0.5), 0, 0)}});
-    scene.add("joint", {{"name", "j" + std::to_string(i)}, {"type", "revolute"}, {"a", link(i - 1)}, {"b", link(i)},
-                        {"anchor", Vec3(length * i, 0, 0)}, {"axis", Vec3::UnitY()}});
+    scene.add("joint", {{"name", "j" + std::to_string(i)},
+                        {"type", "revolute"},
+                        {"a", link(i - 1)},
+                        {"b", link(i)},
+                        {"anchor", Vec3(length * i, 0, 0)},
+                        {"axis", Vec3::UnitY()}});
   }
   return scene;
 }
@@ -96,13 +112,22 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 // of scenes/lblock_viscoelastic.xml.
 SceneSpec lblock(int level, bool viscous, double dt) {
   SceneSpec scene = generatedScene("lblock", dt, 50);
-  ElementSpec& block = scene.add("solid", {{"name", "block"}, {"mesh", "lblock"}, {"level", level},
-                                           {"material", "neo_hooke"}, {"young", 2.26115e3}, {"poisson", 0.395469},
+  ElementSpec& block = scene.add("solid", {{"name", "block"},
+                                           {"mesh", "lblock"},
+                                           {"level", level},
+                                           {"material", "neo_hooke"},
+                                           {"young", 2.26115e3},
+                                           {"poisson", 0.395469},
                                            {"density", 10.0}});
   if (viscous) block.set("branch_lambda", 227.2).set("branch_mu", 49.875).set("viscosity", 100.0);
-  for (const auto& [name, surface, sign] : {std::tuple{"push_top", "load_y10", 1.0}, std::tuple{"push_side", "load_x6", -1.0}})
-    scene.add("traction", {{"name", name}, {"solid", "block"}, {"surface", surface},
-                           {"total_force", Vec3(256, 512, 768) * sign}, {"profile", "hat"}, {"period", 5.0}});
+  for (const auto& [name, surface, sign] :
+       {std::tuple{"push_top", "load_y10", 1.0}, std::tuple{"push_side", "load_x6", -1.0}})
+    scene.add("traction", {{"name", name},
+                           {"solid", "block"},
+                           {"surface", surface},
+                           {"total_force", Vec3(256, 512, 768) * sign},
+                           {"profile", "hat"},
+                           {"period", 5.0}});
   return scene;
 }
 
@@ -111,8 +136,7 @@ SceneSpec lblock(int level, bool viscous, double dt) {
 class Trajectory {
  public:
   Trajectory(const CompiledScene& scene, Scheme scheme, Eigen::VectorXd z, double t, double dt)
-      : dt_(dt), integrator_(*scene.model, scheme, scene.settings.newton), z_(std::move(z)),
-        zNext_(z_.size()), t_(t) {}
+      : dt_(dt), integrator_(*scene.model, scheme, scene.settings.newton), z_(std::move(z)), zNext_(z_.size()), t_(t) {}
 
   // One step; false (see failure()) if Newton failed after all cut-backs.
   bool step() {
@@ -278,7 +302,8 @@ void loadedSolidBenchmark(benchmark::State& state, const std::shared_ptr<LoadedS
     }
     state.PauseTiming();
     const double t = trajectory.time() - dt;
-    startSeconds += secondsOf([&] { integrator.evaluate(trajectory.previousState(), trajectory.previousState(), t, dt); });
+    startSeconds +=
+        secondsOf([&] { integrator.evaluate(trajectory.previousState(), trajectory.previousState(), t, dt); });
     const Assembler* system = nullptr;
     assemblySeconds +=
         secondsOf([&] { system = &integrator.evaluate(trajectory.previousState(), trajectory.state(), t, dt); });
@@ -325,10 +350,8 @@ int main(int argc, char** argv) {
   registerCases("thermo_spring_chain_1000", sceneSpec(thermoSpringChain(1000, 0.05)),
                 {kEemEntropy, kEemTemperature, kMidpoint});
   // rigid multibody: a long open chain under both enforcements, and a spatial closed loop
-  registerCases("rigid_chain_50", sceneSpec(rigidChain(50, Enforcement::AugmentedLagrangian, 1e4, 1e-3)),
-                {kEem});
-  registerCases("rigid_chain_50_penalty", sceneSpec(rigidChain(50, Enforcement::Penalty, 1e8, 1e-3)),
-                {kEem});
+  registerCases("rigid_chain_50", sceneSpec(rigidChain(50, Enforcement::AugmentedLagrangian, 1e4, 1e-3)), {kEem});
+  registerCases("rigid_chain_50_penalty", sceneSpec(rigidChain(50, Enforcement::Penalty, 1e8, 1e-3)), {kEem});
   registerCases("slider_crank_spatial", sceneFile("slider_crank_spatial.xml"), {kEem, kMidpoint});
   // finite-element solids: the tumbling L-block by mesh level (90 to 14 400 nodes)
   registerLBlock("lblock_elastic", 1, false, 20);

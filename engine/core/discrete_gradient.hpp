@@ -48,11 +48,9 @@ inline DiscreteGradient exactGradient(const Jet& jet) { return {jet.grad, jet.he
 // all n! orderings, which is symmetric in (a, b). `mask` selects the active arguments
 // (bit i for argument i); inactive ones keep a's value. f maps a Vec3 to a Jet.
 template <class Fn>
-DiscreteGradient partitionedGradient(const Fn& f, unsigned mask, const Vec3& a, const Vec3& b,
-                                     const Vec3& scale) {
+DiscreteGradient partitionedGradient(const Fn& f, unsigned mask, const Vec3& a, const Vec3& b, const Vec3& scale) {
   // shapleyWeight[n][k]: weight of a subset of size k of the other n-1 arguments
-  static constexpr double shapleyWeight[4][3] = {
-      {0, 0, 0}, {1, 0, 0}, {0.5, 0.5, 0}, {1.0 / 3, 1.0 / 6, 1.0 / 3}};
+  static constexpr double shapleyWeight[4][3] = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.5, 0}, {1.0 / 3, 1.0 / 6, 1.0 / 3}};
   const int n = __builtin_popcount(mask);
 
   // corners of the box, evaluated lazily: argument j at b when bit j of the subset is set
@@ -107,8 +105,7 @@ DiscreteGradient partitionedGradient(const Fn& f, unsigned mask, const Vec3& a, 
 // Gonzalez (midpoint) discrete gradient with the constant diagonal metric G = diag(1/scale^2):
 //   DF = dF(m) + [F(b) - F(a) - dF(m).d] G d / (d.G d),  m = (a+b)/2, d = b - a.
 template <class Fn>
-DiscreteGradient gonzalezGradient(const Fn& f, unsigned mask, const Vec3& a, const Vec3& b,
-                                  const Vec3& scale) {
+DiscreteGradient gonzalezGradient(const Fn& f, unsigned mask, const Vec3& a, const Vec3& b, const Vec3& scale) {
   Vec3 active = Vec3::Zero();
   for (int i = 0; i < 3; ++i)
     if (mask >> i & 1u) active[i] = 1.0;

@@ -4,11 +4,16 @@ namespace mpx {
 
 std::string_view blockName(Block block) {
   switch (block) {
-    case Block::Position: return "position";
-    case Block::Velocity: return "velocity";
-    case Block::Thermal: return "thermal";
-    case Block::Internal: return "internal";
-    case Block::Multiplier: return "multiplier";
+    case Block::Position:
+      return "position";
+    case Block::Velocity:
+      return "velocity";
+    case Block::Thermal:
+      return "thermal";
+    case Block::Internal:
+      return "internal";
+    case Block::Multiplier:
+      return "multiplier";
   }
   return "?";
 }

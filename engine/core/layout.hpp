@@ -2,6 +2,7 @@
 // The state z is one flat vector of blocks. A block exists (has non-zero size) only when some
 // component of the scene asks for it, so a scene pays only for the effects it declares.
 #include <array>
+#include <cassert>
 #include <string_view>
 
 namespace mpx {
@@ -21,7 +22,10 @@ class Layout {
   bool has(Block block) const { return size(block) > 0; }
   int total() const { return total_; }
   // Global index of entry `local` of a block.
-  int dof(Block block, int local) const { return offset(block) + local; }
+  int dof(Block block, int local) const {
+    assert(local >= 0 && local < size(block) && "a block-local index outside its block");
+    return offset(block) + local;
+  }
   Block blockOf(int dof) const;
 
  private:

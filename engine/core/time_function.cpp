@@ -44,10 +44,14 @@ TimeFunction TimeFunction::table(std::vector<double> times, std::vector<double> 
 
 double TimeFunction::operator()(double t) const {
   switch (kind_) {
-    case Kind::Constant: return a_;
-    case Kind::Ramp: return t <= a_ ? 0.0 : t >= b_ ? 1.0 : (t - a_) / (b_ - a_);
-    case Kind::Hat: return t <= 0.5 * a_ ? t : t <= a_ ? a_ - t : 0.0;
-    case Kind::SinePulse: return t >= 0.0 && t <= a_ ? std::sin(M_PI * t / a_) : 0.0;
+    case Kind::Constant:
+      return a_;
+    case Kind::Ramp:
+      return t <= a_ ? 0.0 : t >= b_ ? 1.0 : (t - a_) / (b_ - a_);
+    case Kind::Hat:
+      return t <= 0.5 * a_ ? t : t <= a_ ? a_ - t : 0.0;
+    case Kind::SinePulse:
+      return t >= 0.0 && t <= a_ ? std::sin(M_PI * t / a_) : 0.0;
     case Kind::Table: {
       if (t <= times_.front()) return values_.front();
       if (t >= times_.back()) return values_.back();
@@ -61,10 +65,14 @@ double TimeFunction::operator()(double t) const {
 
 double TimeFunction::slope(double t) const {
   switch (kind_) {
-    case Kind::Constant: return 0.0;
-    case Kind::Ramp: return t >= a_ && t < b_ ? 1.0 / (b_ - a_) : 0.0;
-    case Kind::Hat: return t < 0.5 * a_ ? 1.0 : t < a_ ? -1.0 : 0.0;
-    case Kind::SinePulse: return t >= 0.0 && t < a_ ? M_PI / a_ * std::cos(M_PI * t / a_) : 0.0;
+    case Kind::Constant:
+      return 0.0;
+    case Kind::Ramp:
+      return t >= a_ && t < b_ ? 1.0 / (b_ - a_) : 0.0;
+    case Kind::Hat:
+      return t < 0.5 * a_ ? 1.0 : t < a_ ? -1.0 : 0.0;
+    case Kind::SinePulse:
+      return t >= 0.0 && t < a_ ? M_PI / a_ * std::cos(M_PI * t / a_) : 0.0;
     case Kind::Table: {
       if (t < times_.front() || t >= times_.back()) return 0.0;
       const auto upper = std::upper_bound(times_.begin(), times_.end(), t) - times_.begin();

@@ -3,6 +3,7 @@
 #include "engine/linear/sparse_entry.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 
@@ -59,8 +60,8 @@ void Assembler::clear() {
   flows_ = Flows{};
 }
 
-void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
-                        double weight) {
+void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight) {
+  assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
   double* values = tangent_.valuePtr();
   for (int i = 0; i < local.n; ++i) residual_[dofs[i]] += weight * local.r[i];
   for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];

@@ -30,7 +30,8 @@ class Assembler {
   // Add every component's rate residual and tangent times `weight` (trapezoidal rule: two
   // evaluations of weight 1/2).
   void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
-    add(model, ws, weight, [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
+    add(model, ws, weight,
+        [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
   }
 
  private:
@@ -49,7 +50,6 @@ class Assembler {
       flows_ += componentFlows * weight;
     }
   }
-
 
  public:
   const Eigen::VectorXd& residual() const { return residual_; }

@@ -49,8 +49,8 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
       }
     }
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
-    wholeSystemReason_ = "position dof " + std::to_string(missing - pivotEntry_.begin()) +
-                         " has no kinematic row (no inertia owns it)";
+    wholeSystemReason_ =
+        "position dof " + std::to_string(missing - pivotEntry_.begin()) + " has no kinematic row (no inertia owns it)";
     return false;
   }
 
@@ -146,8 +146,10 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
 }
 
 std::string CondensedSolver::describe() const {
-  const std::string size = std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) + " unknowns factorised";
-  if (velocities_ > 0) return size + " (velocities" + (internal_.active() ? " and internal variables" : "") + " eliminated)";
+  const std::string size =
+      std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) + " unknowns factorised";
+  if (velocities_ > 0)
+    return size + " (velocities" + (internal_.active() ? " and internal variables" : "") + " eliminated)";
   return wholeSystemReason_.empty() ? size : size + "; solved whole because " + wholeSystemReason_;
 }
 

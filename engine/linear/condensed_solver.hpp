@@ -10,8 +10,8 @@
 // split into small independent groups (per quadrature point, per Maxwell element) are then
 // eliminated as well (engine/group_elimination), so that what is factorised is the system of
 // positions, thermal unknowns and multipliers.
-#include "engine/linear/group_elimination.hpp"
 #include "engine/core/layout.hpp"
+#include "engine/linear/group_elimination.hpp"
 #include "engine/linear/sparse_lu.hpp"
 
 #include <Eigen/Sparse>
@@ -68,7 +68,7 @@ class CondensedSolver {
   Eigen::SparseMatrix<double> reduced_;
   std::vector<std::pair<int, int>> directEntries_;  // (entry in K, entry in the condensed matrix)
   std::vector<ProductTerm> productTerms_;
-  std::vector<int> pivotEntry_;                      // per q_i: position of d_i in K
+  std::vector<int> pivotEntry_;                       // per q_i: position of d_i in K
   std::vector<std::vector<RowEntry>> kinematicRows_;  // per q_i
   Eigen::VectorXd reducedRhs_;
   GroupElimination internal_;

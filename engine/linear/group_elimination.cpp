@@ -89,7 +89,8 @@ bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) 
     for (int m : group.members)
       for (int column : group.columns) group.columnEntries.push_back(findEntry(pattern, m, column));
     for (int row : group.rows)
-      for (int column : group.columns) group.fillEntries.push_back(findEntry(reduced_, keptIndex(row), keptIndex(column)));
+      for (int column : group.columns)
+        group.fillEntries.push_back(findEntry(reduced_, keptIndex(row), keptIndex(column)));
   }
   groups_ = std::move(groups);
   factors_.assign(groups_.size(), Eigen::PartialPivLU<Block>(kMaxGroup));
@@ -137,7 +138,8 @@ void GroupElimination::reduceRhs(const Eigen::VectorXd& rhs, Eigen::VectorXd& re
     for (int m = 0; m < s; ++m) own[m] = rhs[group.members[m]];
     const GroupVector x = factors_[g].solve(own);
     for (std::size_t r = 0; r < group.rows.size(); ++r)
-      for (int m = 0; m < s; ++m) reducedRhs[keptIndex(group.rows[r])] -= valueAt(k, group.rowEntries[r * s + m]) * x[m];
+      for (int m = 0; m < s; ++m)
+        reducedRhs[keptIndex(group.rows[r])] -= valueAt(k, group.rowEntries[r * s + m]) * x[m];
   }
 }
 

@@ -41,13 +41,13 @@ class GroupElimination {
   using ColumnCoupling = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxGroup, kMaxCoupling>;
   // Entry positions (-1: structurally zero) of one group, row-major within each list.
   struct Group {
-    std::vector<int> members;           // unknowns of the whole system
-    std::vector<int> blockEntries;      // members x members in the matrix values
-    std::vector<int> rows;              // kept rows that see the group
-    std::vector<int> rowEntries;        // rows x members
-    std::vector<int> columns;           // kept columns the group sees
-    std::vector<int> columnEntries;     // members x columns
-    std::vector<int> fillEntries;       // rows x columns in the reduced values
+    std::vector<int> members;        // unknowns of the whole system
+    std::vector<int> blockEntries;   // members x members in the matrix values
+    std::vector<int> rows;           // kept rows that see the group
+    std::vector<int> rowEntries;     // rows x members
+    std::vector<int> columns;        // kept columns the group sees
+    std::vector<int> columnEntries;  // members x columns
+    std::vector<int> fillEntries;    // rows x columns in the reduced values
   };
   int keptIndex(int i) const { return i < first_ ? i : i - count_; }
   static double valueAt(const double* values, int entry) { return entry < 0 ? 0.0 : values[entry]; }

@@ -4,7 +4,8 @@
 
 namespace mpx {
 
-UmfpackSolver::UmfpackSolver(int size) : solution_(size), integerWork_(size), realWork_(5 * static_cast<std::size_t>(size)) {
+UmfpackSolver::UmfpackSolver(int size)
+    : solution_(size), integerWork_(size), realWork_(5 * static_cast<std::size_t>(size)) {
   umfpack_di_defaults(control_);
   control_[UMFPACK_ORDERING] = UMFPACK_ORDERING_METIS;
 }
@@ -23,8 +24,7 @@ bool UmfpackSolver::factorize(const Eigen::SparseMatrix<double>& matrix, bool) {
     return false;
   if (numeric_) umfpack_di_free_numeric(&numeric_);
   matrix_ = &matrix;
-  return umfpack_di_numeric(colStart, rowIndex, matrix.valuePtr(), symbolic_, &numeric_, control_, info_) ==
-         UMFPACK_OK;
+  return umfpack_di_numeric(colStart, rowIndex, matrix.valuePtr(), symbolic_, &numeric_, control_, info_) == UMFPACK_OK;
 }
 
 void UmfpackSolver::solve(Eigen::VectorXd& rhs) {

@@ -47,8 +47,8 @@ class IdaProblem {
 
  private:
   static int residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* self);
-  static int jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* self,
-                      N_Vector, N_Vector, N_Vector);
+  static int jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* self, N_Vector,
+                      N_Vector, N_Vector);
   static void errorHandler(int code, const char* module, const char* function, char* message, void* self);
   void evaluate(double t, N_Vector y, N_Vector yp, double cj);
   // Index-2 models (GGL constraints): solve the differential rows together with the time
@@ -151,8 +151,8 @@ int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* 
   return modelResidual.allFinite() ? 0 : 1;
 }
 
-int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* user,
-                         N_Vector, N_Vector, N_Vector) {
+int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* user, N_Vector,
+                         N_Vector, N_Vector) {
   auto& self = *static_cast<IdaProblem*>(user);
   self.evaluate(t, y, yp, cj);
   const Eigen::SparseMatrix<double>& K = self.assembler_.tangent();
@@ -162,8 +162,7 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
   if (self.dense_) {
     SUNMatZero(J);
     for (int col = 0; col < n; ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it)
-        SM_ELEMENT_D(J, it.row(), col) = it.value();
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) SM_ELEMENT_D(J, it.row(), col) = it.value();
     for (int a = 0; a < kAccumulators; ++a) SM_ELEMENT_D(J, n + a, n + a) = cj;
     return 0;
   }

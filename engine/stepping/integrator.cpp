@@ -69,8 +69,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   double incrementNorm = INFINITY;
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
   for (int iteration = 0;; ++iteration) {
-    if (iteration > 0 && incrementNorm <= settings_.incrementTolerance &&
-        residualNorm <= settings_.residualTolerance) {
+    if (iteration > 0 && incrementNorm <= settings_.incrementTolerance && residualNorm <= settings_.residualTolerance) {
       outcome.energy += system.flows() * dt;
       return true;
     }

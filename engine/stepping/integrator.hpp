@@ -3,9 +3,9 @@
 // implicit midpoint and trapezoidal rules (derived from the components' rate form), solved by
 // Newton-Raphson with the consistent tangent, a backtracking line search on the residual and
 // a bounded step cut-back.
+#include "engine/core/model.hpp"
 #include "engine/linear/assembler.hpp"
 #include "engine/linear/condensed_solver.hpp"
-#include "engine/core/model.hpp"
 
 #include <Eigen/Dense>
 
@@ -27,7 +27,7 @@ struct StepOutcome {
   bool converged = false;
   int iterations = 0;  // Newton iterations, all sub-steps
   int cutbacks = 0;    // halvings needed
-  Flows energy;  // crossed during the step (J)
+  Flows energy;        // crossed during the step (J)
   // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
   // recovered Newton failure does not allocate
   char failure[200] = "";
@@ -54,8 +54,7 @@ class Integrator {
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
   // evaluated at zNew + step increment_ in trial_); 0 if none does.
-  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
-                    double residualNorm);
+  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew, double residualNorm);
 
   const Model& model_;
   Scheme scheme_;
@@ -64,7 +63,7 @@ class Integrator {
   CondensedSolver solver_;
   Workspace workspace_;
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
-  int unknownsWithScale_;  // dofs before the multiplier block: those in the increment test
+  int unknownsWithScale_;                   // dofs before the multiplier block: those in the increment test
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
 };
 

@@ -18,7 +18,8 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.displacement)
-      throw InputError(scene + ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
+      throw InputError(scene +
+                       ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
                        "<prescribed_velocity>, or use a one-step integrator");
 }
 

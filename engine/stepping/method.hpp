@@ -1,8 +1,8 @@
 #pragma once
 // Integration methods by name, and one entry point that runs any of them on a model:
 // EEM (with the scene's or a forced thermal variable), implicit midpoint, trapezoidal, IDA.
-#include "engine/stepping/ida_simulation.hpp"
 #include "engine/core/model.hpp"
+#include "engine/stepping/ida_simulation.hpp"
 #include "engine/stepping/simulation.hpp"
 
 #include <optional>
@@ -12,7 +12,7 @@ namespace mpx {
 
 struct Method {
   std::string name;
-  std::optional<Scheme> scheme;  // the one-step scheme; none for SUNDIALS IDA
+  std::optional<Scheme> scheme;                    // the one-step scheme; none for SUNDIALS IDA
   std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
   bool isIda() const { return !scheme; }
 };
@@ -36,7 +36,7 @@ struct MethodParameters {
 // `scene` names the scene file in the message.
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene);
 
-RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters,
-                     const StepSink& sink, const ProgressSink& progress = nullptr);
+RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters, const StepSink& sink,
+                     const ProgressSink& progress = nullptr);
 
 }  // namespace mpx

@@ -31,11 +31,12 @@ void RunReporter::report(int step, double time, const Flows& crossed, int newton
   sink_(record_);
 
   // conservation figures: the energy balance against t = 0, the smallest entropy increment
-  summary_.maxEnergyBalanceError =
-      std::max(summary_.maxEnergyBalanceError, balance_.relativeError(measures_.energy, crossed.dissipated,
-                                                                       crossed.externalWork, crossed.boundaryHeat));
+  summary_.maxEnergyBalanceError = std::max(
+      summary_.maxEnergyBalanceError,
+      balance_.relativeError(measures_.energy, crossed.dissipated, crossed.externalWork, crossed.boundaryHeat));
   const double entropyIncrement = measures_.entropy - previousEntropy_;
-  summary_.minEntropyIncrement = step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
+  summary_.minEntropyIncrement =
+      step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
   previousEntropy_ = measures_.entropy;
   summary_.steps = step;
   if (progress_ && step % progressEvery_ == 0) progress_(static_cast<double>(step) / steps_);
@@ -45,8 +46,7 @@ void RunReporter::finish() {
   summary_.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
-                    const ProgressSink& progress) {
+RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink, const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
   summary.linearSystem = integrator.linearSolver().describe();

@@ -1,11 +1,9 @@
 #include "models/fe/discrete_stress.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 
 namespace mpx {
-
 
 DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1)
     : material_(&material),

@@ -79,7 +79,8 @@ double NeoHooke::energyDifference(const Mat3& C0, const Mat3& C1) const {
   const double detDifference = (adjugate(C0) * D).trace() + (C0 * adjugate(D)).trace() + D.determinant();
   if (!(det0 > 0.0) || !(det0 + detDifference > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   const double logJ0 = 0.5 * std::log(det0), logJChange = 0.5 * std::log1p(detDifference / det0);
-  return 0.5 * lame_.mu * D.trace() - lame_.mu * logJChange + 0.5 * lame_.lambda * logJChange * (2.0 * logJ0 + logJChange);
+  return 0.5 * lame_.mu * D.trace() - lame_.mu * logJChange +
+         0.5 * lame_.lambda * logJChange * (2.0 * logJ0 + logJChange);
 }
 
 double NeoHooke::energy(const Mat3& C) const {

@@ -15,8 +15,7 @@ using GridLines = std::array<std::vector<double>, 3>;
 std::vector<double> gridLines(const std::vector<double>& breakpoints, int parts) {
   std::vector<double> lines;
   for (size_t b = 0; b + 1 < breakpoints.size(); ++b)
-    for (int k = 0; k < parts; ++k)
-      lines.push_back(breakpoints[b] + (breakpoints[b + 1] - breakpoints[b]) * k / parts);
+    for (int k = 0; k < parts; ++k) lines.push_back(breakpoints[b] + (breakpoints[b + 1] - breakpoints[b]) * k / parts);
   lines.push_back(breakpoints.back());
   return lines;
 }

@@ -57,12 +57,15 @@ std::vector<CellPoint> cellQuadrature(CellType type, const std::vector<Vec3>& no
   for (const ReferencePoint& p : referenceRule(type, integrand)) {
     CellPoint point;
     ShapeGradients dnDxi;
-    if (type == CellType::Hex8) hexahedronShape(p.xi, point.values, dnDxi);
-    else tetrahedronShape(p.xi, point.values, dnDxi);
+    if (type == CellType::Hex8)
+      hexahedronShape(p.xi, point.values, dnDxi);
+    else
+      tetrahedronShape(p.xi, point.values, dnDxi);
     // dX/dxi and the chain rule dN/dX = dN/dxi (dX/dxi)^-1
     const Mat3 jacobian = x * dnDxi;
     const double det = jacobian.determinant();
-    if (!(det > 0.0)) throw std::domain_error("the cell is inverted or degenerate (det dX/dxi = " + std::to_string(det) + ")");
+    if (!(det > 0.0))
+      throw std::domain_error("the cell is inverted or degenerate (det dX/dxi = " + std::to_string(det) + ")");
     point.gradients = dnDxi * jacobian.inverse();
     point.weight = p.weight * det;
     points.push_back(point);

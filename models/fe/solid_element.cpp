@@ -14,7 +14,8 @@ std::vector<int> collectDofs(const SolidElementSpec& spec) {
     for (int first : spec.positionDofs)
       for (int k = 0; k < 3; ++k) dofs.push_back(first + shift + k);
   if (spec.branch)
-    for (std::size_t k = 0; k < 6 * spec.points.size(); ++k) dofs.push_back(spec.firstInternalDof + static_cast<int>(k));
+    for (std::size_t k = 0; k < 6 * spec.points.size(); ++k)
+      dofs.push_back(spec.firstInternalDof + static_cast<int>(k));
   return dofs;
 }
 
@@ -42,7 +43,9 @@ struct SolidElement::PointEvaluation {
 };
 
 SolidElement::SolidElement(SolidElementSpec spec)
-    : Component(spec.name, collectDofs(spec)), spec_(std::move(spec)), nodes_(static_cast<int>(spec_.positionDofs.size())) {}
+    : Component(spec.name, collectDofs(spec)),
+      spec_(std::move(spec)),
+      nodes_(static_cast<int>(spec_.positionDofs.size())) {}
 
 SolidElement::NodePositions SolidElement::positions(const double* z) const {
   NodePositions x = NodePositions::Zero();
@@ -96,10 +99,12 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
       if (spec_.branch) {
         const Mat3 dBranch = branchStressOf(*spec_.branch, e.strainFactor * dC);
         dStress += dBranch;
-        for (int k = 0; k < 6; ++k) K(gammaRow + k, 3 * b + j) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+        for (int k = 0; k < 6; ++k)
+          K(gammaRow + k, 3 * b + j) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
       }
       const Mat3 dPiola = w * (e.forceGradientFactor * dF * e.stress + e.forceGradient * dStress);
-      for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, 3 * b + j) += s * dPiola * G.row(a).transpose();
+      for (int a = 0; a < nodes_; ++a)
+        K.block<3, 1>(momentumRow + 3 * a, 3 * b + j) += s * dPiola * G.row(a).transpose();
     }
   if (!spec_.branch) return;
 
@@ -109,8 +114,10 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
     dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
     const Mat3 dBranch = branchStressOf(*spec_.branch, -e.gammaFactor * dGamma);
     const Mat3 dPiola = w * e.forceGradient * dBranch;
-    for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, gammaRow + m) += s * dPiola * G.row(a).transpose();
-    for (int k = 0; k < 6; ++k) K(gammaRow + k, gammaRow + m) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+    for (int a = 0; a < nodes_; ++a)
+      K.block<3, 1>(momentumRow + 3 * a, gammaRow + m) += s * dPiola * G.row(a).transpose();
+    for (int k = 0; k < 6; ++k)
+      K(gammaRow + k, gammaRow + m) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
     K(gammaRow + m, gammaRow + m) += e.gammaRateCoefficient;
   }
 }
@@ -133,7 +140,8 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
       e.gammaRate = (gamma1 - gamma0) / args.dt;
       flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
     }
-    assemblePoint(q, e, [&](const Mat3& dC) { return discrete.increment(dC); }, out);
+    assemblePoint(
+        q, e, [&](const Mat3& dC) { return discrete.increment(dC); }, out);
   }
 }
 
@@ -152,7 +160,8 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
       e.gammaRate = viscousStrain(args.zdot, q);
       flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
     }
-    assemblePoint(q, e, [&](const Mat3& dC) { return spec_.material->stressIncrement(C, dC); }, out);
+    assemblePoint(
+        q, e, [&](const Mat3& dC) { return spec_.material->stressIncrement(C, dC); }, out);
   }
 }
 

@@ -19,8 +19,7 @@ void Damper::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&
   const Vec3 dLength1 = d1 / length1;
   const Eigen::Matrix3d dDirection =
       (Eigen::Matrix3d::Identity() - direction * dLength1.transpose()) / (length0 + length1);
-  geometry_.addSeparationTangent(
-      out, (coefficient_ / args.dt) * direction * dLength1.transpose() + force * dDirection);
+  geometry_.addSeparationTangent(out, (coefficient_ / args.dt) * direction * dLength1.transpose() + force * dDirection);
 }
 
 void Damper::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {

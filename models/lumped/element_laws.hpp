@@ -36,8 +36,8 @@ struct ThermoElasticParameters {
   double restLength = 1.0;          // lambda0
   double heatCapacity = 1.0;        // c > 0
   double referenceTemperature = 1.0;
-  double branchStiffness = 0.0;     // mu of the Maxwell branch (0: none)
-  bool hasStretch = true;           // false: a pure heat capacity (reservoir)
+  double branchStiffness = 0.0;  // mu of the Maxwell branch (0: none)
+  bool hasStretch = true;        // false: a pure heat capacity (reservoir)
 };
 
 // Thermo-spring of docs/theory.md section 4.6 (after [Conde Martín 2016] eq 2.19, docs/references.md) in the

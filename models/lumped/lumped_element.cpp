@@ -16,8 +16,7 @@ std::vector<int> LumpedElement::collectDofs(const LumpedElementSpec& spec) {
   return dofs;
 }
 
-LumpedElement::LumpedElement(LumpedElementSpec spec)
-    : Component(spec.name, collectDofs(spec)), spec_(std::move(spec)) {
+LumpedElement::LumpedElement(LumpedElementSpec spec) : Component(spec.name, collectDofs(spec)), spec_(std::move(spec)) {
   const int n = static_cast<int>(dofs().size());
   if (spec_.ends) {
     geometry_.emplace(spec_.ends->first, spec_.ends->second);
@@ -50,7 +49,8 @@ LocalRow LumpedElement::chain(const Vec3& dArguments, const LocalRow (&rows)[3])
   return dArguments[0] * rows[0] + dArguments[1] * rows[1] + dArguments[2] * rows[2];
 }
 
-LumpedElement::Response LumpedElement::respond(const DiscreteGradient& dEnergy, const DiscreteGradient& dEntropy) const {
+LumpedElement::Response LumpedElement::respond(const DiscreteGradient& dEnergy,
+                                               const DiscreteGradient& dEntropy) const {
   Response r;
   // discrete temperature: D_s e / D_s eta
   if (mask_ & kThermalBit) {
@@ -151,7 +151,8 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
 
   // explicit dependence on z (force direction, c' through d) and on zdot (the rates)
   auto K = out.tangent();
-  if (geometry_) geometry_->addSeparationTangent(out, (args.alpha * 2.0 * response.force) * Eigen::Matrix3d::Identity());
+  if (geometry_)
+    geometry_->addSeparationTangent(out, (args.alpha * 2.0 * response.force) * Eigen::Matrix3d::Identity());
   if (localInternal_ >= 0) K(localInternal_, localInternal_) += args.beta * response.viscosity;
   if (localThermal_ >= 0) {
     LocalRow dEntropyRate = chain(entropy.hess * argumentRate, rows);

@@ -62,9 +62,8 @@ class LumpedElement final : public Component {
   // Residual rows shared by both forms and the tangent terms through the response's
   // derivatives (times zCoefficient): momentum f (2 d), internal nu gammaRate - g, thermal
   // theta entropyRate - g^2/nu; also publishes the node temperature.
-  void addBalances(const Response& response, const LocalRow (&rows)[3], double zCoefficient,
-                   const Vec3& forceDirection, double gammaRate, double entropyRate, Workspace& ws,
-                   LocalSystem& out, Flows& flows) const;
+  void addBalances(const Response& response, const LocalRow (&rows)[3], double zCoefficient, const Vec3& forceDirection,
+                   double gammaRate, double entropyRate, Workspace& ws, LocalSystem& out, Flows& flows) const;
 
   LumpedElementSpec spec_;
   std::optional<TwoPointGeometry> geometry_;

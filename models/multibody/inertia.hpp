@@ -30,7 +30,9 @@ class Inertia final : public Component {
 
  private:
   // Gravity force on block b.
-  Vec3 weight(std::size_t b) const { return blocks_[b].translational ? Vec3(blocks_[b].mass * gravity_) : Vec3::Zero(); }
+  Vec3 weight(std::size_t b) const {
+    return blocks_[b].translational ? Vec3(blocks_[b].mass * gravity_) : Vec3::Zero();
+  }
 
   int firstPositionDof_, firstVelocityDof_;
   std::vector<InertiaBlock> blocks_;

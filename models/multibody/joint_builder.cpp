@@ -31,14 +31,22 @@ std::optional<JointType> jointTypeByName(const std::string& name) {
 
 int constraintCount(JointType type) {
   switch (type) {
-    case JointType::Spherical: return 3;
-    case JointType::Revolute: return 5;
-    case JointType::Universal: return 4;
-    case JointType::Cylindrical: return 4;
-    case JointType::Prismatic: return 5;
-    case JointType::Fixed: return 6;
-    case JointType::Distance: return 1;
-    case JointType::Planar: return 3;
+    case JointType::Spherical:
+      return 3;
+    case JointType::Revolute:
+      return 5;
+    case JointType::Universal:
+      return 4;
+    case JointType::Cylindrical:
+      return 4;
+    case JointType::Prismatic:
+      return 5;
+    case JointType::Fixed:
+      return 6;
+    case JointType::Distance:
+      return 1;
+    case JointType::Planar:
+      return 3;
   }
   return 0;
 }
@@ -127,13 +135,19 @@ std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeomet
     forms.push_back(dot(offset, direction(0, n2), 0.0));
   };
   switch (type) {
-    case JointType::Spherical: coincide(); break;
-    case JointType::Revolute: coincide(), alignAxis(); break;
+    case JointType::Spherical:
+      coincide();
+      break;
+    case JointType::Revolute:
+      coincide(), alignAxis();
+      break;
     case JointType::Universal:
       coincide();
       forms.push_back(dot(direction(0, g.axis), direction(1, g.axisB), g.axis.dot(g.axisB)));
       break;
-    case JointType::Cylindrical: alignAxis(), slideAlongAxis(); break;
+    case JointType::Cylindrical:
+      alignAxis(), slideAlongAxis();
+      break;
     case JointType::Prismatic:
       alignAxis(), slideAlongAxis();
       forms.push_back(dot(direction(0, n1), direction(1, n2), 0.0));

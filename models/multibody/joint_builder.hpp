@@ -17,9 +17,9 @@ using Mat3 = Eigen::Matrix3d;
 struct Attachment {
   enum class Kind { Ground, Point, Body };
   Kind kind = Kind::Ground;
-  int firstPositionDof = -1;  // x (Point) or phi, d1, d2, d3 (Body)
-  Vec3 position = Vec3::Zero();             // initial x or phi
-  Mat3 directors = Mat3::Identity();        // initial d1, d2, d3 as columns (Body)
+  int firstPositionDof = -1;          // x (Point) or phi, d1, d2, d3 (Body)
+  Vec3 position = Vec3::Zero();       // initial x or phi
+  Mat3 directors = Mat3::Identity();  // initial d1, d2, d3 as columns (Body)
 };
 
 // An affine map q -> R^3.

@@ -13,7 +13,7 @@ Jet cosineEnergy(double k, double u, double v, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
   const double r2 = u * u + v * v, r = std::sqrt(r2), r3 = r2 * r, r5 = r3 * r2;
   const double w = c * u + s * v, wAngle = -s * u + c * v;  // w and dw/dangle
-  Jet f;  // f = w / r
+  Jet f;                                                    // f = w / r
   f.value = w / r;
   f.grad = Vec3(c / r - w * u / r3, s / r - w * v / r3, wAngle / r);
   f.hess(0, 0) = -2.0 * c * u / r3 - w / r3 + 3.0 * w * u * u / r5;
@@ -189,9 +189,9 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
   for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * qRate).transpose();
   const ConstraintRow dRateDqRate = angle.grad.transpose() * J;
   const ConstraintVector direction = J.transpose() * angle.grad;
-  K.block(n_, 0, n_, n_) += args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J +
-                                          direction * (dForce * dRateDq)) +
-                            args.beta * direction * (dForce * dRateDqRate);
+  K.block(n_, 0, n_, n_) +=
+      args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * (dForce * dRateDq)) +
+      args.beta * direction * (dForce * dRateDqRate);
   for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * forceOnArguments[i] * spec_.invariants[i].hessian;
 
   double power = force * rate;

@@ -18,17 +18,17 @@ namespace mpx {
 
 struct JointForceSpec {
   std::string name;
-  bool revolute = true;                 // revolute: invariants (u, v); prismatic: (s)
-  std::vector<int> positionDofs;        // q of the invariants
-  int velocityShift = 0;                // velocity dof = position dof + velocityShift
+  bool revolute = true;           // revolute: invariants (u, v); prismatic: (s)
+  std::vector<int> positionDofs;  // q of the invariants
+  int velocityShift = 0;          // velocity dof = position dof + velocityShift
   std::vector<QuadraticForm> invariants;
-  double stiffness = 0.0, rest = 0.0;   // spring
-  double cubicStiffness = 0.0;          // prismatic: k3 of k3/4 (s - s0)^4
+  double stiffness = 0.0, rest = 0.0;             // spring
+  double cubicStiffness = 0.0;                    // prismatic: k3 of k3/4 (s - s0)^4
   double branchStiffness = 0.0, viscosity = 1.0;  // Maxwell branch (with internalDof)
-  int internalDof = -1;                 // gamma of the Maxwell branch, -1: none
-  double damping = 0.0;                 // viscous coefficient
+  int internalDof = -1;                           // gamma of the Maxwell branch, -1: none
+  double damping = 0.0;                           // viscous coefficient
   double friction = 0.0, frictionVelocity = 1.0;  // smoothed Coulomb
-  int heatDof = -1;                     // thermal dof heated by the dissipation, -1: none
+  int heatDof = -1;                               // thermal dof heated by the dissipation, -1: none
 };
 
 class JointForce final : public Component {
@@ -55,8 +55,7 @@ class JointForce final : public Component {
   ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;
   unsigned mask() const;
   // Send the dissipated power (with its tangent row) to the heat node, or to the flows.
-  void deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out,
-               Flows& flows) const;
+  void deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out, Flows& flows) const;
 
   JointForceSpec spec_;
   int n_;  // number of constrained positions

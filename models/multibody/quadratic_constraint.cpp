@@ -9,7 +9,8 @@ std::vector<int> QuadraticConstraint::collectDofs(const ConstraintSpec& spec) {
   for (int p : spec.positionDofs) dofs.push_back(p + spec.velocityShift);
   // lambda_k then mu_k (augmented Lagrangian only)
   if (spec.enforcement == Enforcement::AugmentedLagrangian)
-    for (std::size_t k = 0; k < 2 * spec.forms.size(); ++k) dofs.push_back(spec.firstMultiplierDof + static_cast<int>(k));
+    for (std::size_t k = 0; k < 2 * spec.forms.size(); ++k)
+      dofs.push_back(spec.firstMultiplierDof + static_cast<int>(k));
   return dofs;
 }
 
@@ -49,8 +50,8 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
     const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.value(q0) + form.value(q1));
     const ConstraintVector gradientMid = form.gradientAt(qMid);
     r.segment(n, n) += force * gradientMid;
-    K.block(n, 0, n, n) += 0.5 * force * form.hessian +
-                           (0.5 * spec_.stiffness) * gradientMid * form.gradientAt(q1).transpose();
+    K.block(n, 0, n, n) +=
+        0.5 * force * form.hessian + (0.5 * spec_.stiffness) * gradientMid * form.gradientAt(q1).transpose();
     if (!augmented()) continue;
     // lambda's row: the constraint at the end of the step; mu is not used by EEM (mu = 0)
     const int lambda = 2 * n + k, mu = 2 * n + m + k;

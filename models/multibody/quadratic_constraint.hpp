@@ -20,7 +20,8 @@ namespace mpx {
 // Largest number of position dofs one constraint set couples (two rigid bodies).
 inline constexpr int kMaxConstrainedDofs = 24;
 using ConstraintVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstrainedDofs, 1>;
-using ConstraintMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
+using ConstraintMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
 using ConstraintRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxConstrainedDofs>;
 
 struct QuadraticForm {

@@ -28,8 +28,8 @@ std::string ElementReader::text(const char* attribute) {
   // name what is there, so a misspelt attribute is easy to spot
   std::string present;
   for (const auto& [name, value] : element_.attributes) present += (present.empty() ? "" : ", ") + name;
-  fail(std::string("missing required attribute '") + attribute + "' (attributes given: " +
-       (present.empty() ? "none" : present) + ")");
+  fail(std::string("missing required attribute '") + attribute +
+       "' (attributes given: " + (present.empty() ? "none" : present) + ")");
 }
 
 std::string ElementReader::text(const char* attribute, const std::string& fallback) {
@@ -40,7 +40,8 @@ std::string ElementReader::text(const char* attribute, const std::string& fallba
 double ElementReader::parseNumber(const char* attribute, const std::string& token) const {
   char* end = nullptr;
   const double value = std::strtod(token.c_str(), &end);
-  if (token.empty() || *end != '\0') fail(std::string("attribute '") + attribute + "': '" + token + "' is not a number");
+  if (token.empty() || *end != '\0')
+    fail(std::string("attribute '") + attribute + "': '" + token + "' is not a number");
   if (!std::isfinite(value)) fail(std::string("attribute '") + attribute + "' must be finite, got '" + token + "'");
   return value;
 }

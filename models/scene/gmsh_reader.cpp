@@ -24,12 +24,12 @@ struct ElementKind {
 
 const ElementKind* elementKind(long long type) {
   static const std::map<long long, ElementKind> kinds = {
-      {1, {2, 1, "2-node line"}},         {2, {3, 2, "3-node triangle"}},      {3, {4, 2, "4-node quadrangle"}},
-      {4, {4, 3, "4-node tetrahedron"}},  {5, {8, 3, "8-node hexahedron"}},    {6, {6, 3, "6-node prism"}},
-      {7, {5, 3, "5-node pyramid"}},      {8, {3, 1, "3-node line"}},          {9, {6, 2, "6-node triangle"}},
-      {10, {9, 2, "9-node quadrangle"}},  {11, {10, 3, "10-node tetrahedron"}}, {12, {27, 3, "27-node hexahedron"}},
-      {13, {18, 3, "18-node prism"}},     {14, {14, 3, "14-node pyramid"}},    {15, {1, 0, "point"}},
-      {16, {8, 2, "8-node quadrangle"}},  {17, {20, 3, "20-node hexahedron"}}, {18, {15, 3, "15-node prism"}},
+      {1, {2, 1, "2-node line"}},        {2, {3, 2, "3-node triangle"}},       {3, {4, 2, "4-node quadrangle"}},
+      {4, {4, 3, "4-node tetrahedron"}}, {5, {8, 3, "8-node hexahedron"}},     {6, {6, 3, "6-node prism"}},
+      {7, {5, 3, "5-node pyramid"}},     {8, {3, 1, "3-node line"}},           {9, {6, 2, "6-node triangle"}},
+      {10, {9, 2, "9-node quadrangle"}}, {11, {10, 3, "10-node tetrahedron"}}, {12, {27, 3, "27-node hexahedron"}},
+      {13, {18, 3, "18-node prism"}},    {14, {14, 3, "14-node pyramid"}},     {15, {1, 0, "point"}},
+      {16, {8, 2, "8-node quadrangle"}}, {17, {20, 3, "20-node hexahedron"}},  {18, {15, 3, "15-node prism"}},
       {19, {13, 3, "13-node pyramid"}}};
   auto kind = kinds.find(type);
   return kind == kinds.end() ? nullptr : &kind->second;
@@ -447,9 +447,10 @@ class GmshParser {
       for (int physical : element.physicals) mesh.volumes[groupName(3, physical)].push_back(cell->second);
     }
     if (mesh.cells.empty())
-      fail(elementsLine_, "the mesh has no volume elements (4-node tetrahedra or 8-node hexahedra); with physical "
-                          "groups defined, Gmsh saves only their elements: add a Physical Volume or set "
-                          "Mesh.SaveAll=1");
+      fail(elementsLine_,
+           "the mesh has no volume elements (4-node tetrahedra or 8-node hexahedra); with physical "
+           "groups defined, Gmsh saves only their elements: add a Physical Volume or set "
+           "Mesh.SaveAll=1");
     if (mesh.volumes.empty()) {
       mesh.volumes["all"].resize(mesh.cells.size());
       std::iota(mesh.volumes["all"].begin(), mesh.volumes["all"].end(), 0);
@@ -476,12 +477,12 @@ class GmshParser {
 
   std::string path_;
   std::vector<std::string> lines_;
-  double version_ = 0;  // 0 until $MeshFormat is read
-  int nodesLine_ = 0, elementsLine_ = 0;  // header lines of $Nodes and $Elements, 0 while not seen
+  double version_ = 0;                                // 0 until $MeshFormat is read
+  int nodesLine_ = 0, elementsLine_ = 0;              // header lines of $Nodes and $Elements, 0 while not seen
   std::map<std::pair<int, int>, std::string> names_;  // (dimension, physical tag) -> name
   bool hasEntities_ = false;
   std::map<std::pair<int, long long>, std::vector<int>> entityPhysicals_;  // (dimension, entity tag) -> physical tags
-  std::unordered_map<long long, int> nodeIndex_;  // Gmsh node tag -> compact index
+  std::unordered_map<long long, int> nodeIndex_;                           // Gmsh node tag -> compact index
   std::vector<Vec3> nodes_;
   std::vector<GmshElement> elements_;
 };

@@ -75,10 +75,17 @@ void buildForce(ElementReader& in, SceneBuild& build, DofRange&) {
 
 const std::vector<ElementKind>& lumpedElementKinds() {
   static const std::vector<ElementKind> kinds = {
-      {"mass", [](ElementReader&, SceneBuild&) { return DofDemand{3, 0, 0, 0}; }, buildMass},
+      {"mass",
+       [](ElementReader&, SceneBuild&) {
+         return DofDemand{3, 0, 0, 0};
+       },
+       buildMass},
       {"anchor", nullptr, buildAnchor},
       {"spring", nullptr, [](ElementReader& in, SceneBuild& b, DofRange& d) { buildHookeElement(in, b, d, false); }},
-      {"maxwell", [](ElementReader&, SceneBuild&) { return DofDemand{0, 0, 1, 0}; },
+      {"maxwell",
+       [](ElementReader&, SceneBuild&) {
+         return DofDemand{0, 0, 1, 0};
+       },
        [](ElementReader& in, SceneBuild& b, DofRange& d) { buildHookeElement(in, b, d, true); }},
       {"damper", nullptr, buildDamper},
       {"force", nullptr, buildForce},

@@ -45,8 +45,9 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   if (!(J.minCoeff() > 0.0)) in.fail("the inertia tensor must be positive definite");
   const Vec3 E(0.5 * (J[1] + J[2] - J[0]), 0.5 * (J[2] + J[0] - J[1]), 0.5 * (J[0] + J[1] - J[2]));
   if (!(E.minCoeff() > 0.0))
-    in.fail("principal moments must satisfy the strict triangle inequality J_i < J_j + J_k "
-            "(the director mass matrix needs (J_j + J_k - J_i)/2 > 0)");
+    in.fail(
+        "principal moments must satisfy the strict triangle inequality J_i < J_j + J_k "
+        "(the director mass matrix needs (J_j + J_k - J_i)/2 > 0)");
 
   const int phi = dofs.take(Block::Position, 12), phiRate = phi + build.velocityShift();
   build.state.segment<3>(phi) = position;

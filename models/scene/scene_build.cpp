@@ -10,11 +10,16 @@ DofRange::DofRange(const Layout& layout, const DofDemand& first, const DofDemand
 
 int& DofRange::of(DofDemand& demand, Block block) {
   switch (block) {
-    case Block::Position: return demand.positions;
-    case Block::Thermal: return demand.thermal;
-    case Block::Internal: return demand.internal;
-    case Block::Multiplier: return demand.multipliers;
-    case Block::Velocity: break;
+    case Block::Position:
+      return demand.positions;
+    case Block::Thermal:
+      return demand.thermal;
+    case Block::Internal:
+      return demand.internal;
+    case Block::Multiplier:
+      return demand.multipliers;
+    case Block::Velocity:
+      break;
   }
   throw std::logic_error("velocity dofs come with their positions");
 }
@@ -106,7 +111,8 @@ int SceneBuild::addThermalNode(const std::string& name, int dof, double dofScale
 }
 
 void SceneBuild::addComponent(std::unique_ptr<Component> component) {
-  if (const auto node = thermalNodes.find(component->name()); node != thermalNodes.end() && node->second.thermalDof >= 0)
+  if (const auto node = thermalNodes.find(component->name());
+      node != thermalNodes.end() && node->second.thermalDof >= 0)
     node->second.ownerDofs = component->dofs();
   components.push_back(std::move(component));
 }
@@ -167,7 +173,8 @@ std::vector<int> SceneBuild::solidNodes(ElementReader& in, const SolidPlacement&
 }
 
 const ElementKind* findElementKind(const std::string& tag) {
-  for (const auto* family : {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+  for (const auto* family :
+       {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
     for (const ElementKind& kind : *family)
       if (tag == kind.tag) return &kind;
   return nullptr;
@@ -175,7 +182,8 @@ const ElementKind* findElementKind(const std::string& tag) {
 
 std::string elementTags() {
   std::string tags;
-  for (const auto* family : {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+  for (const auto* family :
+       {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
     for (const ElementKind& kind : *family) tags += (tags.empty() ? "" : ", ") + std::string(kind.tag);
   return tags;
 }

@@ -91,8 +91,8 @@ class SceneBuild {
   Eigen::VectorXd state, scale;  // initial state; Newton's scale per dof (0: not set)
   std::vector<std::unique_ptr<Component>> components;
   std::vector<std::string> thermalNodeNames;
-  std::map<std::string, Endpoint> points;            // masses, anchors, bodies' centres
-  std::map<std::string, Attachment> attachments;     // what joints may attach to
+  std::map<std::string, Endpoint> points;         // masses, anchors, bodies' centres
+  std::map<std::string, Attachment> attachments;  // what joints may attach to
   std::map<std::string, ThermalNodeRef> thermalNodes;
   std::map<std::string, DeclaredJoint> joints;
   std::vector<BodyFrame> bodyFrames;

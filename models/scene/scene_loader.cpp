@@ -74,10 +74,14 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
                      ": <metriplex>: the scene has nothing to integrate (no mass, body, solid, thermal element "
                      "or reservoir)");
   setMechanicalScales(build, scene.settings.tEnd);
-  auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
-                                       build.thermalNodeNames, build.state, build.scale,
-                                       std::move(build.prescribedMotions));
-  return {scene.name, scene.settings, std::move(model), std::move(build.bodyFrames), std::move(build.jointCoordinates),
+  auto model =
+      std::make_unique<Model>(build.layout, build.variable, std::move(build.components), build.thermalNodeNames,
+                              build.state, build.scale, std::move(build.prescribedMotions));
+  return {scene.name,
+          scene.settings,
+          std::move(model),
+          std::move(build.bodyFrames),
+          std::move(build.jointCoordinates),
           std::move(build.solids)};
 }
 

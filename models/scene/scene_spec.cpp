@@ -14,7 +14,8 @@ AttributeValue::AttributeValue(double value) : text_(fmt::format("{}", value)) {
 
 AttributeValue::AttributeValue(int value) : text_(std::to_string(value)) {}
 
-AttributeValue::AttributeValue(const Vec3& value, int) : text_(fmt::format("{} {} {}", value.x(), value.y(), value.z())) {}
+AttributeValue::AttributeValue(const Vec3& value, int)
+    : text_(fmt::format("{} {} {}", value.x(), value.y(), value.z())) {}
 
 AttributeValue::AttributeValue(const std::vector<double>& values) : text_(fmt::format("{}", fmt::join(values, " "))) {}
 

@@ -50,9 +50,12 @@ MeshSource readMeshSource(ElementReader& in) {
 
 Mesh buildMesh(const MeshSource& source, const std::string& sceneFile) {
   Mesh mesh;
-  if (source.kind == "lblock") mesh = makeLBlockMesh(source.level);
-  else if (source.kind == "box") mesh = makeBoxMesh(source.origin, source.size, source.cells);
-  else mesh = readGmshMesh((std::filesystem::path(sceneFile).parent_path() / source.kind).string());
+  if (source.kind == "lblock")
+    mesh = makeLBlockMesh(source.level);
+  else if (source.kind == "box")
+    mesh = makeBoxMesh(source.origin, source.size, source.cells);
+  else
+    mesh = readGmshMesh((std::filesystem::path(sceneFile).parent_path() / source.kind).string());
   for (Vec3& node : mesh.nodes) node += source.offset;
   return mesh;
 }
@@ -88,7 +91,6 @@ std::vector<Vec3> cellNodes(const Mesh& mesh, const Cell& cell) {
   return nodes;
 }
 
-
 DofDemand declareSolid(ElementReader& in, SceneBuild& build) {
   const MeshSource source = readMeshSource(in);
   std::shared_ptr<const Mesh> mesh;
@@ -118,12 +120,16 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   double density = 0.0;
   try {
     const LameParameters lame = LameParameters::fromYoung(in.positive("young"), in.number("poisson"));
-    if (law == "neo_hooke") material = std::make_shared<NeoHooke>(lame);
-    else if (law == "svk") material = std::make_shared<SaintVenantKirchhoff>(lame);
-    else in.fail("material must be 'neo_hooke' or 'svk', got '" + law + "'");
+    if (law == "neo_hooke")
+      material = std::make_shared<NeoHooke>(lame);
+    else if (law == "svk")
+      material = std::make_shared<SaintVenantKirchhoff>(lame);
+    else
+      in.fail("material must be 'neo_hooke' or 'svk', got '" + law + "'");
     density = in.positive("density");
     if (in.has("viscosity"))
-      branch = ViscousBranch{{in.nonNegative("branch_lambda", 0.0), in.positive("branch_mu")}, in.positive("viscosity")};
+      branch =
+          ViscousBranch{{in.nonNegative("branch_lambda", 0.0), in.positive("branch_mu")}, in.positive("viscosity")};
   } catch (const std::invalid_argument& error) {
     in.fail(error.what());
   }
@@ -302,7 +308,8 @@ const std::vector<ElementKind>& solidElementKinds() {
       {"solid", declareSolid, buildSolid},
       {"traction", nullptr, buildTraction},
       {"body_force", nullptr, buildBodyForce},
-      {"clamp", nullptr, [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Clamp); }},
+      {"clamp", nullptr,
+       [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Clamp); }},
       {"prescribed_velocity", nullptr,
        [](ElementReader& in, SceneBuild& b, DofRange&) { buildPrescribedMotion(in, b, MotionKind::Velocity); }},
       {"prescribed_displacement", nullptr,

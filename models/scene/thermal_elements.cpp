@@ -102,11 +102,21 @@ void buildHeatLink(ElementReader& in, SceneBuild& build, DofRange&) {
 
 const std::vector<ElementKind>& thermalElementKinds() {
   static const std::vector<ElementKind> kinds = {
-      {"thermo_spring", [](ElementReader&, SceneBuild&) { return DofDemand{0, 1, 0, 0}; },
+      {"thermo_spring",
+       [](ElementReader&, SceneBuild&) {
+         return DofDemand{0, 1, 0, 0};
+       },
        [](ElementReader& in, SceneBuild& b, DofRange& d) { buildThermoElement(in, b, d, false); }},
-      {"thermo_maxwell", [](ElementReader&, SceneBuild&) { return DofDemand{0, 1, 1, 0}; },
+      {"thermo_maxwell",
+       [](ElementReader&, SceneBuild&) {
+         return DofDemand{0, 1, 1, 0};
+       },
        [](ElementReader& in, SceneBuild& b, DofRange& d) { buildThermoElement(in, b, d, true); }},
-      {"reservoir", [](ElementReader&, SceneBuild&) { return DofDemand{0, 1, 0, 0}; }, buildReservoir},
+      {"reservoir",
+       [](ElementReader&, SceneBuild&) {
+         return DofDemand{0, 1, 0, 0};
+       },
+       buildReservoir},
       {"fixed_temperature", nullptr, buildFixedTemperature},
       {"heat_link", nullptr, buildHeatLink},
   };

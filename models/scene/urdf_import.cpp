@@ -57,11 +57,16 @@ bool hasCoordinate(const urdf::Joint& joint) {
 const char* sceneJointType(const urdf::Joint& joint) {
   switch (joint.type) {
     case urdf::Joint::REVOLUTE:
-    case urdf::Joint::CONTINUOUS: return "revolute";
-    case urdf::Joint::PRISMATIC: return "prismatic";
-    case urdf::Joint::PLANAR: return "planar";
-    case urdf::Joint::FIXED: return "fixed";
-    default: return nullptr;
+    case urdf::Joint::CONTINUOUS:
+      return "revolute";
+    case urdf::Joint::PRISMATIC:
+      return "prismatic";
+    case urdf::Joint::PLANAR:
+      return "planar";
+    case urdf::Joint::FIXED:
+      return "fixed";
+    default:
+      return nullptr;
   }
 }
 
@@ -118,8 +123,10 @@ class ParserLog final : public console_bridge::OutputHandler {
   ParserLog& operator=(const ParserLog&) = delete;
 
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors_ += (errors_.empty() ? "" : "; ") + text;
-    else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) warn(path_, text);
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
+      errors_ += (errors_.empty() ? "" : "; ") + text;
+    else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN)
+      warn(path_, text);
   }
   const std::string& errors() const { return errors_; }
 
@@ -137,9 +144,9 @@ urdf::ModelInterfaceSharedPtr parse(const UrdfFile& file) {
 
 // A link at t = 0 and what carries it in the scene.
 struct LinkState {
-  Pose frame = Pose::Identity();        // world pose of the link frame
+  Pose frame = Pose::Identity();  // world pose of the link frame
   Vec3 angularVelocity = Vec3::Zero();
-  Vec3 originVelocity = Vec3::Zero();   // velocity of the frame's origin
+  Vec3 originVelocity = Vec3::Zero();  // velocity of the frame's origin
   std::string carrier;  // scene name of its body, or of the body or anchor a massless link is merged into
 };
 
@@ -205,8 +212,9 @@ void UrdfTranslator::checkNames() const {
       throw InputError(file_.path() + ": an initial state is given for joint '" + name +
                        "', which the URDF does not have");
     if (!hasCoordinate(*joint))
-      file_.fail("joint", name, "takes no initial position or velocity (only revolute, continuous and prismatic "
-                                "joints have one coordinate)");
+      file_.fail("joint", name,
+                 "takes no initial position or velocity (only revolute, continuous and prismatic "
+                 "joints have one coordinate)");
   }
 }
 
@@ -236,17 +244,20 @@ void UrdfTranslator::addChildren(const urdf::Link& parent, const LinkState& pare
     const urdf::Link& child = *robot_.getLink(joint->child_link_name);
     const auto [reached, first] = parentJoint_.emplace(child.name, joint->name);
     if (!first)
-      file_.fail("link", child.name, "is the child of two joints, '" + reached->second + "' and '" + joint->name +
-                                         "': a URDF must be a tree");
+      file_.fail(
+          "link", child.name,
+          "is the child of two joints, '" + reached->second + "' and '" + joint->name + "': a URDF must be a tree");
     if (joint->mimic)
-      file_.fail("joint", joint->name, "mimics joint '" + joint->mimic->joint_name +
-                                           "': mimic joints are not supported (import it as an independent joint)");
+      file_.fail("joint", joint->name,
+                 "mimics joint '" + joint->mimic->joint_name +
+                     "': mimic joints are not supported (import it as an independent joint)");
     LinkState state = childState(*joint, parentState);
     if (massless(child)) {
       // a massless link rigidly fixed to its parent is merged into the parent's carrier
       if (joint->type != urdf::Joint::FIXED)
-        file_.fail("link", child.name, "has no mass (no <inertial>, or mass and inertia 0) but joint '" + joint->name +
-                                           "' moves it: give it a positive mass or fix it to its parent");
+        file_.fail("link", child.name,
+                   "has no mass (no <inertial>, or mass and inertia 0) but joint '" + joint->name +
+                       "' moves it: give it a positive mass or fix it to its parent");
       state.carrier = parentState.carrier;
     } else {
       addBody(child, state);
@@ -331,8 +342,9 @@ void UrdfTranslator::checkInertia(const urdf::Link& link, const Eigen::Matrix3d&
     file_.fail("link", link.name,
                "the inertia tensor must be positive definite; its principal moments are " + numbers(J));
   if (!(J[0] + J[1] > J[2]))
-    file_.fail("link", link.name, "the principal moments " + numbers(J) +
-                                      " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need");
+    file_.fail("link", link.name,
+               "the principal moments " + numbers(J) +
+                   " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need");
 }
 
 void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child) {

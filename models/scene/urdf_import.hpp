@@ -19,11 +19,11 @@ struct UrdfJointState {
 };
 
 struct UrdfImportOptions {
-  bool floating = false;  // the root link moves freely instead of being fixed to the ground
+  bool floating = false;         // the root link moves freely instead of being fixed to the ground
   Vec3 position = Vec3::Zero();  // world pose of the root link's frame
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   std::map<std::string, UrdfJointState> initial;  // by URDF joint name; the others start at 0, at rest
-  std::string prefix;  // put before every element name, so a robot can be included twice
+  std::string prefix;                             // put before every element name, so a robot can be included twice
 };
 
 // Validate the URDF at `path` and append its scene elements to `scene`, in an order the

@@ -77,7 +77,8 @@ UrdfImportOptions readUrdfOptions(ElementReader& in, const XMLElement& include) 
     if (spec.tag != "initial") initial.fail("a <urdf> element holds <initial> elements only");
     const std::string joint = initial.text("joint");
     const UrdfJointState state{initial.number("position", 0.0), initial.number("velocity", 0.0)};
-    if (!options.initial.emplace(joint, state).second) initial.fail("joint '" + joint + "' has an initial state already");
+    if (!options.initial.emplace(joint, state).second)
+      initial.fail("joint '" + joint + "' has an initial state already");
     initial.finish();
   }
   return options;

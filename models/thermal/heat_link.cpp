@@ -41,7 +41,8 @@ void HeatLink::exchange(const Workspace& ws, LocalSystem& out, Flows& flows) con
     r[localThermal_[e]] -= heatIn;
     for (int k = 0; k < node[other]->count; ++k)
       K(localThermal_[e], ownerToLocal_[other][k]) -= conductivity_ * node[other]->grad[k];
-    for (int k = 0; k < node[e]->count; ++k) K(localThermal_[e], ownerToLocal_[e][k]) += conductivity_ * node[e]->grad[k];
+    for (int k = 0; k < node[e]->count; ++k)
+      K(localThermal_[e], ownerToLocal_[e][k]) += conductivity_ * node[e]->grad[k];
   }
 }
 

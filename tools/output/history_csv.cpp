@@ -23,10 +23,12 @@ HistoryCsv::~HistoryCsv() {
 
 void HistoryCsv::write(const StepRecord& r) {
   const Measures& m = *r.measures;
-  fmt::print(file_, "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{:.17g}",
-             r.time, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat, m.momentum.x(),
-             m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
-             r.newtonIterations, r.cutbacks, m.constraintViolation);
+  fmt::print(
+      file_,
+      "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{:.17g}",
+      r.time, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat, m.momentum.x(),
+      m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
+      r.newtonIterations, r.cutbacks, m.constraintViolation);
   for (double temperature : m.nodeTemperature) fmt::print(file_, ",{:.17g}", temperature);
   std::fputc('\n', file_);
 }

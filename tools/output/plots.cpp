@@ -59,10 +59,11 @@ void renderPlots(const std::filesystem::path& dir, const std::string& sceneName,
   const std::filesystem::path script = dir / "plots.gp";
   {
     auto out = fmt::output_file(script.string());
-    out.print("{}", header(dir / "work_precision.png",
-                           fmt::format("Work-precision, {} (t_end = {:g})", sceneName, tEnd)));
+    out.print("{}",
+              header(dir / "work_precision.png", fmt::format("Work-precision, {} (t_end = {:g})", sceneName, tEnd)));
     out.print("set logscale xy\nset format x '10^{{%L}}'\nset format y '10^{{%L}}'\n");
-    out.print("set xlabel 'CPU time [s]'\nset ylabel 'relative error at t = t_{{end}} (positions, temperatures) [-]'\n");
+    out.print(
+        "set xlabel 'CPU time [s]'\nset ylabel 'relative error at t = t_{{end}} (positions, temperatures) [-]'\n");
     out.print("{}", plotCommand(wpFiles, wpLabels, "1:2", "linespoints lw 2 pt 7"));
     out.print("{}", header(dir / "energy_error.png", fmt::format("Energy balance error, {}", sceneName)));
     out.print("set logscale y\nset format y '10^{{%L}}'\nset format x '%g'\n");

@@ -4,8 +4,8 @@
 // stress and viscous strain per cell), one frame per output interval, and at the end a
 // picture of the last frame, DIR/<solid>.png, coloured by the von Mises stress.
 #include "engine/stepping/simulation.hpp"
-#include "tools/output/vtk_writer.hpp"
 #include "models/scene/scene_loader.hpp"
+#include "tools/output/vtk_writer.hpp"
 
 #include <filesystem>
 
