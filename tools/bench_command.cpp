@@ -207,7 +207,7 @@ int benchCommand(const BenchRequest& request) {
       parameters.newton = settings.newton;
       parameters.dt = method.isIda() ? tEnd / 100 : value;
       parameters.relativeTolerance = value;
-      parameters.absoluteTolerance = 1e-2 * value;
+      parameters.absoluteTolerance = value;
       const bool keepSeries = value == (method.isIda() ? seriesTolerance : seriesStep);
       BenchRun run = measure(model, method, parameters, request.repeats, keepSeries);
       (method.isIda() ? run.rtol : run.dt) = value;

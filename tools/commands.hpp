@@ -17,7 +17,8 @@ struct RunRequest {
   std::string out;                      // empty: a directory under out/ named after the scene
   std::optional<double> frameInterval;  // bodies.csv and joints.csv rows; empty: every step
   // IDA only
-  double relativeTolerance = 1e-6, absoluteTolerance = 1e-8;
+  double relativeTolerance = 1e-6;
+  std::optional<double> absoluteTolerance;  // empty: relativeTolerance
   int maxOrder = 5;
   std::optional<double> outputStep;
 };

@@ -47,8 +47,8 @@ int main(int argc, char** argv) {
   run->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
   run->add_option("--rtol", request.relativeTolerance, "ida: relative tolerance")->capture_default_str();
-  run->add_option("--atol", request.absoluteTolerance, "ida: absolute tolerance, times each dof's scale")
-      ->capture_default_str();
+  run->add_option("--atol", request.absoluteTolerance,
+                  "ida: absolute tolerance, times each dof's scale (default: --rtol)");
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   run->add_option("--output-interval", request.frameInterval,

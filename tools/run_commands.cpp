@@ -74,7 +74,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
   parameters.newton = scene.settings.newton;
   parameters.relativeTolerance = request.relativeTolerance;
-  parameters.absoluteTolerance = request.absoluteTolerance;
+  parameters.absoluteTolerance = request.absoluteTolerance.value_or(request.relativeTolerance);
   parameters.maxOrder = request.maxOrder;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
@@ -115,9 +115,9 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
   if (s.ida)
     fmt::print(
         "  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
-        "{} nonlinear iterations, {} error-test failures\n",
+        "{} nonlinear iterations, {} error-test failures, {} convergence failures\n",
         s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
-        s.ida->errorTestFailures);
+        s.ida->errorTestFailures, s.ida->convergenceFailures);
   else {
     fmt::print("  cut-backs                {}\n", s.cutbacks);
     fmt::print("  linear system            {}\n", s.linearSystem);

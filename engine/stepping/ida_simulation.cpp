@@ -4,7 +4,7 @@
 
 #include <Eigen/SparseLU>
 
-#include <ida/ida.h>
+#include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
@@ -22,8 +22,9 @@ namespace {
 
 // Models up to this many unknowns use a dense Jacobian; larger ones sparse KLU.
 constexpr int kLargestDenseSystem = 64;
-// The boundary-energy accumulators appended to the state: dissipated, external work, boundary heat.
-constexpr int kAccumulators = 3;
+// The energies crossing the boundary, integrated as IDA quadratures (outside the Newton system
+// and the error test): dissipated, external work, boundary heat.
+constexpr int kQuadratures = 3;
 // Absolute tolerance of the multipliers (forces, in the model's units) in IDA's Newton test;
 // they are left out of the error test, and the GGL multiplier mu stays at round-off, so a
 // tolerance tied to the positions' would ask Newton to resolve noise.
@@ -42,11 +43,14 @@ class IdaProblem {
   // Integrate to tout; false on failure (see error()).
   bool advanceTo(double tout);
   const double* state() const { return N_VGetArrayPointer(y_); }
+  // Dissipated energy, external work and boundary heat since t = 0, at the last output.
+  Flows crossed() const;
   const std::string& error() const { return error_; }
   IdaStatistics statistics() const;
 
  private:
   static int residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* self);
+  static int flows(realtype t, N_Vector y, N_Vector yp, N_Vector rates, void* self);
   static int jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* self, N_Vector,
                       N_Vector, N_Vector);
   static void errorHandler(int code, const char* module, const char* function, char* message, void* self);
@@ -62,7 +66,7 @@ class IdaProblem {
   int modelSize_;
   bool dense_;
   SUNContext context_ = nullptr;
-  N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr, atol_ = nullptr;
+  N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr, atol_ = nullptr, crossed_ = nullptr;
   SUNMatrix jacobian_ = nullptr;
   SUNLinearSolver linearSolver_ = nullptr;
   void* ida_ = nullptr;
@@ -74,8 +78,8 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
       assembler_(model),
       workspace_(model.makeWorkspace()),
       modelSize_(model.layout().total()),
-      dense_(model.layout().total() + kAccumulators <= kLargestDenseSystem) {
-  const int n = modelSize_ + kAccumulators;
+      dense_(model.layout().total() <= kLargestDenseSystem) {
+  const int n = modelSize_;
   check(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
   y_ = N_VNew_Serial(n, context_);
   yp_ = N_VNew_Serial(n, context_);
@@ -84,16 +88,18 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   double* y = N_VGetArrayPointer(y_);
   double* atol = N_VGetArrayPointer(atol_);
   for (int i = 0; i < n; ++i) {
-    y[i] = i < modelSize_ ? model.initialState()[i] : 0.0;
-    atol[i] = options.absoluteTolerance * (i < modelSize_ ? model.dofScale()[i] : 1.0);
-    if (i < modelSize_ && model.layout().blockOf(i) == Block::Multiplier) atol[i] = kMultiplierTolerance;
+    y[i] = model.initialState()[i];
+    atol[i] = model.layout().blockOf(i) == Block::Multiplier ? kMultiplierTolerance
+                                                             : options.absoluteTolerance * model.dofScale()[i];
   }
   N_VConst(0.0, yp_);
   // multipliers are algebraic (and left out of the error test: the GGL form has index 2);
   // every other unknown of the rate form is differential
   double* id = N_VGetArrayPointer(id_);
   const Layout& layout = model.layout();
-  for (int i = 0; i < n; ++i) id[i] = i < modelSize_ && layout.blockOf(i) == Block::Multiplier ? 0.0 : 1.0;
+  for (int i = 0; i < n; ++i) id[i] = layout.blockOf(i) == Block::Multiplier ? 0.0 : 1.0;
+  crossed_ = N_VNew_Serial(kQuadratures, context_);
+  N_VConst(0.0, crossed_);
 
   ida_ = IDACreate(context_);
   check(IDASetErrHandlerFn(ida_, errorHandler, this), "IDASetErrHandlerFn");
@@ -104,8 +110,9 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   check(IDASetSuppressAlg(ida_, SUNTRUE), "IDASetSuppressAlg");
   check(IDASetMaxOrd(ida_, options.maxOrder), "IDASetMaxOrd");
   check(IDASetMaxNumSteps(ida_, 1000000), "IDASetMaxNumSteps");
+  check(IDAQuadInit(ida_, flows, crossed_), "IDAQuadInit");
 
-  const auto nonZeros = static_cast<sunindextype>(assembler_.tangent().nonZeros() + kAccumulators);
+  const auto nonZeros = static_cast<sunindextype>(assembler_.tangent().nonZeros());
   jacobian_ = dense_ ? SUNDenseMatrix(n, n, context_) : SUNSparseMatrix(n, n, nonZeros, CSC_MAT, context_);
   linearSolver_ = dense_ ? SUNLinSol_Dense(y_, jacobian_, context_) : SUNLinSol_KLU(y_, jacobian_, context_);
   check(IDASetLinearSolver(ida_, linearSolver_, jacobian_), "IDASetLinearSolver");
@@ -116,7 +123,7 @@ IdaProblem::~IdaProblem() {
   IDAFree(&ida_);
   if (linearSolver_) SUNLinSolFree(linearSolver_);
   if (jacobian_) SUNMatDestroy(jacobian_);
-  for (N_Vector v : {y_, yp_, id_, atol_})
+  for (N_Vector v : {y_, yp_, id_, atol_, crossed_})
     if (v) N_VDestroy(v);
   if (context_) SUNContext_Free(&context_);
 }
@@ -141,12 +148,6 @@ int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* 
   double* out = N_VGetArrayPointer(r);
   const Eigen::VectorXd& modelResidual = self.assembler_.residual();
   std::copy(modelResidual.data(), modelResidual.data() + self.modelSize_, out);
-  // accumulators: D' = dissipated power, W' = external power, Q' = boundary heat rate
-  const double* rate = N_VGetArrayPointer(yp) + self.modelSize_;
-  const Flows& flows = self.assembler_.flows();
-  out[self.modelSize_] = rate[0] - flows.dissipated;
-  out[self.modelSize_ + 1] = rate[1] - flows.externalWork;
-  out[self.modelSize_ + 2] = rate[2] - flows.boundaryHeat;
   // a non-finite residual is recoverable: IDA retries with a smaller step
   return modelResidual.allFinite() ? 0 : 1;
 }
@@ -157,13 +158,10 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
   self.evaluate(t, y, yp, cj);
   const Eigen::SparseMatrix<double>& K = self.assembler_.tangent();
   const int n = self.modelSize_;
-  // the accumulator rows enter with cj on the diagonal only: their dependence on z is left
-  // out (IDA's Newton is a modified Newton; nothing else depends on the accumulators)
   if (self.dense_) {
     SUNMatZero(J);
     for (int col = 0; col < n; ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) SM_ELEMENT_D(J, it.row(), col) = it.value();
-    for (int a = 0; a < kAccumulators; ++a) SM_ELEMENT_D(J, n + a, n + a) = cj;
     return 0;
   }
   sunindextype* colStart = SUNSparseMatrix_IndexPointers(J);
@@ -172,13 +170,23 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
   std::copy(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, colStart);
   std::copy(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), rowIndex);
   std::copy(K.valuePtr(), K.valuePtr() + K.nonZeros(), values);
-  for (int a = 0; a < kAccumulators; ++a) {
-    const auto entry = static_cast<sunindextype>(K.nonZeros() + a);
-    rowIndex[entry] = n + a;
-    values[entry] = cj;
-    colStart[n + a + 1] = entry + 1;
-  }
   return 0;
+}
+
+int IdaProblem::flows(realtype t, N_Vector y, N_Vector yp, N_Vector rates, void* user) {
+  auto& self = *static_cast<IdaProblem*>(user);
+  self.evaluate(t, y, yp, 0.0);
+  const Flows& flows = self.assembler_.flows();
+  double* out = N_VGetArrayPointer(rates);
+  out[0] = flows.dissipated;
+  out[1] = flows.externalWork;
+  out[2] = flows.boundaryHeat;
+  return std::isfinite(out[0] + out[1] + out[2]) ? 0 : 1;
+}
+
+Flows IdaProblem::crossed() const {
+  const double* q = N_VGetArrayPointer(crossed_);
+  return {q[0], q[1], q[2]};
 }
 
 bool IdaProblem::initialise(double firstOutput) {
@@ -231,12 +239,12 @@ bool IdaProblem::initialiseAlgebraic() {
   const Eigen::VectorXd solution = lu.solve(rhs);
   double* yp = N_VGetArrayPointer(yp_);
   for (int i = 0; i < n; ++i) (algebraic(i) ? y[i] : yp[i]) = solution[i];
-  return IDAReInit(ida_, 0.0, y_, yp_) >= 0;
+  return IDAReInit(ida_, 0.0, y_, yp_) >= 0 && IDAQuadReInit(ida_, crossed_) >= 0;
 }
 
 bool IdaProblem::advanceTo(double tout) {
   realtype reached = 0.0;
-  return IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0;
+  return IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0 && IDAGetQuad(ida_, &reached, crossed_) >= 0;
 }
 
 IdaStatistics IdaProblem::statistics() const {
@@ -246,6 +254,7 @@ IdaStatistics IdaProblem::statistics() const {
   IDAGetNumJacEvals(ida_, &s.jacobianEvaluations);
   IDAGetNumNonlinSolvIters(ida_, &s.nonlinearIterations);
   IDAGetNumErrTestFails(ida_, &s.errorTestFailures);
+  IDAGetNumNonlinSolvConvFails(ida_, &s.convergenceFailures);
   return s;
 }
 
@@ -274,11 +283,9 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
       fail(k, reporter.last().time, "IDASolve failed");
       break;
     }
-    // the model's unknowns, then the accumulated boundary energies
     reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
     const IdaStatistics stats = ida.statistics();
-    reporter.report(k, tout, {ida.state()[n], ida.state()[n + 1], ida.state()[n + 2]},
-                    static_cast<int>(stats.nonlinearIterations - previousIterations),
+    reporter.report(k, tout, ida.crossed(), static_cast<int>(stats.nonlinearIterations - previousIterations),
                     static_cast<int>(stats.errorTestFailures - previousErrorTestFailures));
     previousIterations = stats.nonlinearIterations;
     previousErrorTestFailures = stats.errorTestFailures;

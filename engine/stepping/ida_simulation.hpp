@@ -1,15 +1,19 @@
 #pragma once
-// The SUNDIALS IDA baseline: the model's rate form F(t, z, zdot) = 0 (Component::rateLocal)
-// integrated by variable-order, variable-step BDF with the analytic Jacobian
-// dF/dz + cj dF/dzdot, dense for small models and sparse (KLU) for large ones. Energies that
-// cross the boundary are integrated as three extra unknowns (D' = dissipated power, ...).
+// The SUNDIALS IDA baseline (run through IDAS, the same BDF solver with quadratures): the model's rate form F(t, z,
+// zdot) = 0 (Component::rateLocal) integrated by variable-order, variable-step BDF with the analytic Jacobian dF/dz +
+// cj dF/dzdot, dense for small models and sparse (KLU) for large ones. Energies that cross the boundary (D' =
+// dissipated power, W' = external power, Q' = boundary heat rate) are IDA quadratures: integrated along, outside the
+// Newton system and the error test.
 #include "engine/stepping/simulation.hpp"
 
 namespace mpx {
 
 struct IdaOptions {
   double relativeTolerance = 1e-6;
-  double absoluteTolerance = 1e-8;  // times each dof's scale (Model::dofScale)
+  // Times each dof's scale (Model::dofScale): the error of dof i is measured against
+  // rtol |z_i| + atol scale_i. Equal to rtol by default, so that a small component is judged
+  // relative to its scale rather than to zero.
+  double absoluteTolerance = 1e-6;
   int maxOrder = 5;
   double outputStep = 0.0;  // history rows at multiples of this
   double tEnd = 0.0;

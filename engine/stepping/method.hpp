@@ -26,7 +26,7 @@ struct MethodParameters {
   double tEnd = 0.0;
   NewtonSettings newton;
   double relativeTolerance = 1e-6;  // IDA
-  double absoluteTolerance = 1e-8;  // IDA, times each dof's scale
+  double absoluteTolerance = 1e-6;  // IDA, times each dof's scale
   int maxOrder = 5;                 // IDA
 };
 

@@ -37,6 +37,7 @@ struct IdaStatistics {
   long jacobianEvaluations = 0;
   long nonlinearIterations = 0;
   long errorTestFailures = 0;
+  long convergenceFailures = 0;  // of the nonlinear (Newton) solver
 };
 
 // The energy balance E + D - W - Q - E_0 of a run: the largest |balance| so far relative to the
