@@ -22,7 +22,9 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       increment_(model.layout().total()),
       trial_(model.layout().total()),
       unknownsWithScale_(model.layout().offset(Block::Multiplier)),
-      halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())) {}
+      halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())),
+      lastStart_(model.layout().total()),
+      lastEnd_(model.layout().total()) {}
 
 Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
   assembler_.clear();
@@ -63,11 +65,17 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     return system.relativeResidualNorm();
   };
 
-  zNew = zOld;
+  // a predictor whose residual is not finite is no start: begin from the old state
   Assembler& system = evaluate(zOld, zNew, t, dt);
   double residualNorm = rescaledNorm(system);
+  if (!std::isfinite(residualNorm)) {
+    zNew = zOld;
+    evaluate(zOld, zNew, t, dt);
+    residualNorm = rescaledNorm(system);
+  }
   double incrementNorm = INFINITY;
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
+  bool refresh = factorizedDt_ != dt || settings_.reuseContraction <= 0.0;
   for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance && residualNorm <= settings_.residualTolerance) {
       outcome.energy += system.flows() * dt;
@@ -77,27 +85,40 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
     // backtrack along the Newton direction until the residual is finite and decreases (a
     // full step near the solution, where the residual is already at round-off level); if no
-    // step decreases it, the reused pivots may be to blame: pivot afresh once
+    // step decreases it, a kept factorisation is refreshed, then the reused pivots are
+    // replaced, before the step counts as failed
     double step = 1.0;
     for (bool repivot = false;;) {
-      if (!solver_.factorize(system.tangent(), repivot))
-        return fail("singular tangent", iteration, incrementNorm, residualNorm);
+      if (refresh && !refactorize(dt, repivot)) return fail("singular tangent", iteration, incrementNorm, residualNorm);
       solver_.solve(system.residual(), increment_);
       step = lineSearch(zOld, t, dt, zNew, residualNorm);
       if (step > 0.0) break;
-      if (repivot)
+      if (refresh && repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
-      repivot = true;
+      repivot = refresh;
+      refresh = true;
       evaluate(zOld, zNew, t, dt);  // restore the tangent at zNew
     }
     zNew.swap(trial_);
     ++outcome.iterations;
     // multipliers have no natural scale; their rows' residual (the constraints) judges them
+    const double previousIncrementNorm = incrementNorm;
     incrementNorm = step * (increment_.head(unknownsWithScale_).array().abs() /
                             (zNew.head(unknownsWithScale_).array().abs() + scale.head(unknownsWithScale_).array()))
                                .maxCoeff();
     residualNorm = rescaledNorm(system);
+    // keep the factorisation while the iteration contracts well (or has converged)
+    refresh =
+        settings_.reuseContraction <= 0.0 || (incrementNorm > settings_.incrementTolerance &&
+                                              !(incrementNorm <= settings_.reuseContraction * previousIncrementNorm));
   }
+}
+
+bool Integrator::refactorize(double dt, bool repivot) {
+  factorizedDt_ = 0.0;
+  if (!solver_.factorize(assembler_.tangent(), repivot)) return false;
+  factorizedDt_ = dt;
+  return true;
 }
 
 double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
@@ -115,7 +136,14 @@ double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, 
 
 bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                               StepOutcome& outcome) {
+  // the first attempt of a step that continues the last one starts from the extrapolation
+  const bool continues = level == 0 && settings_.predictor && t == lastTime_ + lastDt_ && z == lastEnd_;
+  if (continues)
+    zNew = z + (dt / lastDt_) * (lastEnd_ - lastStart_);
+  else
+    zNew = z;
   if (solveStep(z, t, dt, zNew, outcome)) return true;
+  factorizedDt_ = 0.0;  // what failed here is not to be reused by the cut-back
   if (level == settings_.maxCutbacks) return false;
   // cut back: two half steps through an intermediate state of this level
   ++outcome.cutbacks;
@@ -127,6 +155,12 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
 StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew) {
   StepOutcome outcome;
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
+  if (outcome.converged) {
+    lastStart_ = z;
+    lastEnd_ = zNew;
+    lastTime_ = t;
+    lastDt_ = dt;
+  }
   return outcome;
 }
 

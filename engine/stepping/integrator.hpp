@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
+
 #include <string>
 #include <vector>
 
@@ -21,6 +23,14 @@ struct NewtonSettings {
   double residualTolerance = 1e-8;    // max |R_i| / (sum of |terms| in R_i)
   int maxIterations = 25;
   int maxCutbacks = 6;  // each halves the step
+  // Simplified Newton: keep a factorisation across iterations and steps while the increments
+  // contract by at least this factor per iteration; refresh it (from the current tangent)
+  // when they do not, when dt changes or when the line search fails. 0 (default): full
+  // Newton, which measures faster on every scene so far (docs/performance.md).
+  double reuseContraction = 0.0;
+  // Start each step from the linear extrapolation of the previous two states (when the step
+  // continues the last one) instead of from the old state.
+  bool predictor = true;
 };
 
 struct StepOutcome {
@@ -51,7 +61,10 @@ class Integrator {
   void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
+  // Newton from the initial guess in zNew.
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
+  // Factorise the tangent of the last evaluation; false if singular.
+  bool refactorize(double dt, bool repivot);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
   // evaluated at zNew + step increment_ in trial_); 0 if none does.
   double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew, double residualNorm);
@@ -65,6 +78,11 @@ class Integrator {
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
   int unknownsWithScale_;                   // dofs before the multiplier block: those in the increment test
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
+  // simplified Newton: the step size the factorisation belongs to (0: none held)
+  double factorizedDt_ = 0.0;
+  // predictor: the last accepted step, lastStart_ at lastTime_ to lastEnd_ over lastDt_
+  Eigen::VectorXd lastStart_, lastEnd_;
+  double lastTime_ = NAN, lastDt_ = 0.0;
 };
 
 }  // namespace mpx
