@@ -1,5 +1,6 @@
 #pragma once
-// Shared helpers for the tests: scenes from inline XML or scenes/, and runs collected in memory.
+// Shared helpers for the tests: fixture scenes from tests/data/, runs collected in memory, and
+// conservation checks computed from a run's history.
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
 

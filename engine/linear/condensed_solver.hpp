@@ -8,7 +8,7 @@
 // mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
 // Scenes whose pattern does not have this structure are solved whole. Internal variables that
 // split into small independent groups (per quadrature point, per Maxwell element) are then
-// eliminated as well (engine/group_elimination), so that what is factorised is the system of
+// eliminated as well (engine/linear/group_elimination), so that what is factorised is the system of
 // positions, thermal unknowns and multipliers.
 #include "engine/core/layout.hpp"
 #include "engine/linear/group_elimination.hpp"
@@ -27,8 +27,10 @@ class CondensedSolver {
   // `pattern`: the fixed pattern of every tangent this solver will see.
   CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern);
 
-  // Factorise the condensed form of `tangent`, which must stay alive and unchanged until the
-  // next factorize (solve reads it). Returns false if it is singular.
+  // Factorise the condensed form of `tangent`, which must stay alive until the next factorize:
+  // solve reads its kinematic rows and velocity couplings. If the tangent is re-assembled in
+  // between (simplified Newton), solve mixes its current values with the kept factorisation,
+  // an approximate inverse, which is all simplified Newton asks. Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);

@@ -11,8 +11,8 @@ namespace mpx {
 struct IdaOptions {
   double relativeTolerance = 1e-6;
   // Times each dof's scale (Model::dofScale): the error of dof i is measured against
-  // rtol |z_i| + atol scale_i. Equal to rtol by default, so that a small component is judged
-  // relative to its scale rather than to zero.
+  // rtol |z_i| + atol scale_i. Set it equal to rtol (what the CLI does unless --atol is
+  // given), so that a small component is judged relative to its scale rather than to zero.
   double absoluteTolerance = 1e-6;
   int maxOrder = 5;
   double outputStep = 0.0;  // history rows at multiples of this

@@ -89,7 +89,8 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     // replaced, before the step counts as failed
     double step = 1.0;
     for (bool repivot = false;;) {
-      if (refresh && !refactorize(dt, repivot)) return fail("singular tangent", iteration, incrementNorm, residualNorm);
+      if (refresh && !refactorize(dt, repivot, outcome))
+        return fail("singular tangent", iteration, incrementNorm, residualNorm);
       solver_.solve(system.residual(), increment_);
       step = lineSearch(zOld, t, dt, zNew, residualNorm);
       if (step > 0.0) break;
@@ -114,8 +115,9 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   }
 }
 
-bool Integrator::refactorize(double dt, bool repivot) {
+bool Integrator::refactorize(double dt, bool repivot, StepOutcome& outcome) {
   factorizedDt_ = 0.0;
+  ++outcome.factorizations;
   if (!solver_.factorize(assembler_.tangent(), repivot)) return false;
   factorizedDt_ = dt;
   return true;
@@ -136,12 +138,15 @@ double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, 
 
 bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                               StepOutcome& outcome) {
-  // the first attempt of a step that continues the last one starts from the extrapolation
+  // the first attempt of a step that continues the last one starts from the extrapolation;
+  // if Newton fails from there, it tries again from the old state before cutting back
   const bool continues = level == 0 && settings_.predictor && t == lastTime_ + lastDt_ && z == lastEnd_;
-  if (continues)
+  if (continues) {
     zNew = z + (dt / lastDt_) * (lastEnd_ - lastStart_);
-  else
-    zNew = z;
+    if (solveStep(z, t, dt, zNew, outcome)) return true;
+    factorizedDt_ = 0.0;
+  }
+  zNew = z;
   if (solveStep(z, t, dt, zNew, outcome)) return true;
   factorizedDt_ = 0.0;  // what failed here is not to be reused by the cut-back
   if (level == settings_.maxCutbacks) return false;

@@ -35,9 +35,10 @@ struct NewtonSettings {
 
 struct StepOutcome {
   bool converged = false;
-  int iterations = 0;  // Newton iterations, all sub-steps
-  int cutbacks = 0;    // halvings needed
-  Flows energy;        // crossed during the step (J)
+  int iterations = 0;      // Newton iterations, all sub-steps
+  int cutbacks = 0;        // halvings needed
+  int factorizations = 0;  // of the step tangent, all sub-steps
+  Flows energy;            // crossed during the step (J)
   // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
   // recovered Newton failure does not allocate
   char failure[200] = "";
@@ -64,7 +65,7 @@ class Integrator {
   // Newton from the initial guess in zNew.
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
   // Factorise the tangent of the last evaluation; false if singular.
-  bool refactorize(double dt, bool repivot);
+  bool refactorize(double dt, bool repivot, StepOutcome& outcome);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
   // evaluated at zNew + step increment_ in trial_); 0 if none does.
   double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew, double residualNorm);

@@ -61,6 +61,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next);
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
+    summary.factorizations += outcome.factorizations;
     if (!outcome.converged) {
       summary.failed = true;
       summary.failedStep = n;

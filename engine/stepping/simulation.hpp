@@ -63,6 +63,7 @@ inline constexpr double kBlowUpEnergyError = 0.1;
 struct RunSummary {
   int steps = 0;
   long newtonIterations = 0;
+  long factorizations = 0;  // of the step tangent (one-step schemes)
   int cutbacks = 0;
   double wallSeconds = 0.0;
   // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy seen (EnergyBalance):

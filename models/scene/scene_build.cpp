@@ -27,6 +27,7 @@ int& DofRange::of(DofDemand& demand, Block block) {
 int DofRange::of(const DofDemand& demand, Block block) { return of(const_cast<DofDemand&>(demand), block); }
 
 int DofRange::take(Block block, int count) {
+  if (count == 0) return -1;
   int& taken = of(taken_, block);
   if (taken + count > of(declared_, block))
     throw std::logic_error("an element builds more " + std::string(blockName(block)) + " dofs (" +
@@ -110,11 +111,9 @@ int SceneBuild::addThermalNode(const std::string& name, int dof, double dofScale
   return node;
 }
 
-void SceneBuild::addComponent(std::unique_ptr<Component> component) {
-  if (const auto node = thermalNodes.find(component->name());
-      node != thermalNodes.end() && node->second.thermalDof >= 0)
-    node->second.ownerDofs = component->dofs();
-  components.push_back(std::move(component));
+void SceneBuild::addThermalNodeOwner(const std::string& node, std::unique_ptr<Component> component) {
+  thermalNodes.at(node).ownerDofs = component->dofs();
+  addComponent(std::move(component));
 }
 
 ConstraintSettings SceneBuild::constraintSettings(ElementReader& in) const {

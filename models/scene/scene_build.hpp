@@ -36,7 +36,8 @@ class DofRange {
  public:
   DofRange(const Layout& layout, const DofDemand& first, const DofDemand& declared);
   // Global index of the first of `count` consecutive new dofs of `block` (Position,
-  // Thermal, Internal or Multiplier). Throws std::logic_error beyond the declaration.
+  // Thermal, Internal or Multiplier; -1 for count 0). Throws std::logic_error beyond the
+  // declaration.
   int take(Block block, int count);
   // Throws std::logic_error naming `where` if some declared dof was not taken.
   void checkAllTaken(const std::string& where) const;
@@ -77,8 +78,9 @@ struct DeclaredJoint {
 class SceneBuild {
  public:
   SceneBuild(const SceneSpec& spec, ThermalVariable variable) : spec(spec), variable(variable) {}
+  SceneBuild(SceneSpec&&, ThermalVariable) = delete;
 
-  const SceneSpec& spec;
+  const SceneSpec& spec;  // outlives the build (compileScene's argument)
   const ThermalVariable variable;
 
   // Filled by the declare pass.
@@ -120,9 +122,10 @@ class SceneBuild {
   // Register the thermal node `name` held by `dof` (-1: a prescribed temperature); returns
   // its node index.
   int addThermalNode(const std::string& name, int dof, double scale);
-  // Add a component; a thermal node it owns learns its local dofs (what its published
-  // temperature's derivative refers to).
-  void addComponent(std::unique_ptr<Component> component);
+  void addComponent(std::unique_ptr<Component> component) { components.push_back(std::move(component)); }
+  // Add the component that owns thermal node `node`: the node learns the component's local
+  // dofs, which the derivative of its published temperature refers to.
+  void addThermalNodeOwner(const std::string& node, std::unique_ptr<Component> component);
 
   // enforcement="..." and stiffness="..." of a constraint element, over the scene defaults.
   ConstraintSettings constraintSettings(ElementReader& in) const;

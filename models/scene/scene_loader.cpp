@@ -1,5 +1,7 @@
 #include "models/scene/scene_loader.hpp"
 
+#include "engine/stepping/method.hpp"
+
 #include "models/scene/urdf_scene.hpp"
 #include "models/scene/xml_scene.hpp"
 
@@ -14,9 +16,23 @@ namespace {
 // Position scale of a scene without any length (e.g. only thermal nodes).
 constexpr double kDefaultLength = 1.0;
 
+// What the XML reader checks on <simulation>, <solver>, <gravity> and <constraints>, for
+// scenes built in code.
 void checkSettings(const SceneSpec& scene) {
-  if (!(scene.settings.dt > 0.0) || !(scene.settings.tEnd > 0.0))
-    throw InputError(scene.label + ": the simulation needs dt > 0 and t_end > 0");
+  const SceneSettings& s = scene.settings;
+  const NewtonSettings& n = s.newton;
+  auto require = [&](bool holds, const std::string& what) {
+    if (!holds) throw InputError(scene.label + ": " + what);
+  };
+  require(s.dt > 0.0 && std::isfinite(s.dt) && s.tEnd > 0.0 && std::isfinite(s.tEnd),
+          "the simulation needs finite dt > 0 and t_end > 0");
+  require(methodByName(s.integrator).has_value(), "unknown integrator '" + s.integrator + "'");
+  require(n.incrementTolerance > 0.0 && n.residualTolerance > 0.0, "Newton tolerances must be positive");
+  require(n.maxIterations >= 1 && n.maxCutbacks >= 0, "max_iterations must be at least 1, max_cutbacks at least 0");
+  require(n.reuseContraction >= 0.0 && n.reuseContraction < 1.0, "reuse_contraction must be in [0, 1)");
+  require(scene.gravity.allFinite(), "gravity must be finite");
+  require(scene.constraints.stiffness > 0.0 && std::isfinite(scene.constraints.stiffness),
+          "the constraint stiffness must be positive");
 }
 
 // The state layout: each element's declared dofs, in element order within each block.

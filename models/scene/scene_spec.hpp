@@ -2,8 +2,9 @@
 // A scene as data, between the front ends and the compiler: the XML reader, the URDF reader
 // and C++ code all produce a SceneSpec, and compileScene (scene_loader.hpp) turns it into a
 // Model. Elements carry the tags and attribute names of the XML format, so
-// docs/scene-format.md describes both ways of writing a scene and every value is validated
-// by the same reader, whichever front end wrote it.
+// docs/scene-format.md describes both ways of writing a scene and every element's attributes
+// are validated by the same reader, whichever front end wrote them; compileScene checks the
+// typed settings as the XML reader does.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
 #include "engine/stepping/integrator.hpp"
@@ -37,7 +38,9 @@ class AttributeValue {
   AttributeValue(bool value) : text_(value ? "true" : "false") {}
   // a 3-vector, or any Eigen expression of one (Vec3::UnitZ(), 2 * v, ...)
   template <class Derived>
-  AttributeValue(const Eigen::MatrixBase<Derived>& value) : AttributeValue(Vec3(value), 0) {}
+  AttributeValue(const Eigen::MatrixBase<Derived>& value) : AttributeValue(Vec3(value), 0) {
+    static_assert(Derived::SizeAtCompileTime == 3, "an attribute vector has 3 components");
+  }
   AttributeValue(const std::vector<double>& values);
   AttributeValue(const Eigen::Quaterniond& rotation);  // "w x y z"
   const std::string& text() const { return text_; }
@@ -90,7 +93,8 @@ struct SceneSpec {
   std::vector<ElementSpec> elements;
 
   // Append an element, e.g. add("mass", {{"name", "m1"}, {"mass", 2.0}, {"position", Vec3(1, 0, 0)}}).
-  // Elements may refer only to elements added before them.
+  // Elements may refer only to elements added before them. The reference returned is valid
+  // until the next add; the element's location takes the label as it is now.
   ElementSpec& add(const std::string& tag, std::initializer_list<Attribute> attributes = {});
 };
 

@@ -62,7 +62,8 @@ void buildThermoElement(ElementReader& in, SceneBuild& build, DofRange& dofs, bo
   const double c = (build.positionOf(spec.ends->second) - build.positionOf(spec.ends->first)).squaredNorm();
   build.state[spec.thermalDof] = initialThermalState(in, *law, c, gamma);
   spec.argumentScale = Vec3(p.restLength * p.restLength, thermalScale(build, p), 1.0);
-  build.addComponent(std::make_unique<LumpedElement>(std::move(spec)));
+  const std::string node = spec.name;
+  build.addThermalNodeOwner(node, std::make_unique<LumpedElement>(std::move(spec)));
 }
 
 void buildReservoir(ElementReader& in, SceneBuild& build, DofRange& dofs) {
@@ -81,7 +82,8 @@ void buildReservoir(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   spec.thermalNode = build.addThermalNode(spec.name, spec.thermalDof, thermalScale(build, p));
   build.state[spec.thermalDof] = initialThermalState(in, *law, 0.0, 0.0);
   spec.argumentScale = Vec3(1.0, thermalScale(build, p), 1.0);
-  build.addComponent(std::make_unique<LumpedElement>(std::move(spec)));
+  const std::string node = spec.name;
+  build.addThermalNodeOwner(node, std::make_unique<LumpedElement>(std::move(spec)));
 }
 
 void buildFixedTemperature(ElementReader& in, SceneBuild& build, DofRange&) {

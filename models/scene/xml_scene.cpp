@@ -51,7 +51,10 @@ void readSolver(ElementReader& in, NewtonSettings& n) {
   n.residualTolerance = in.positive("residual_tolerance", n.residualTolerance);
   n.maxIterations = in.count("max_iterations", n.maxIterations);
   n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks);
+  n.predictor = in.flag("predictor", n.predictor);
+  n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
   if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
+  if (!(n.reuseContraction < 1.0)) in.fail("reuse_contraction must be below 1 (0: full Newton)");
 }
 
 ConstraintSettings readConstraints(ElementReader& in) {
