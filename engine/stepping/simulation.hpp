@@ -56,8 +56,9 @@ class EnergyBalance {
   double initial_, scale_, largestError_ = 0.0;
 };
 
-// A run whose largest relative energy balance error (EnergyBalance) exceeds this has blown up:
-// the one threshold the tests, bench and docs use.
+// A run whose largest relative energy balance error exceeds this has blown up: the one
+// threshold of bench (against EnergyBalance's scale) and of the tests (against |E_0|, for runs
+// that start with energy).
 inline constexpr double kBlowUpEnergyError = 0.1;
 
 struct RunSummary {
