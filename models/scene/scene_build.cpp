@@ -45,6 +45,22 @@ void DofRange::checkAllTaken(const std::string& where) const {
                              std::string(blockName(block)) + " dofs but built " + std::to_string(of(taken_, block)));
 }
 
+namespace {
+
+// The entry of `named` that attribute `attribute` names; otherwise fail with "no <kinds> named
+// '...' <declaredWhere>".
+template <class Map>
+const typename Map::mapped_type& declared(const Map& named, ElementReader& in, const char* attribute, const char* kinds,
+                                          const char* declaredWhere) {
+  const std::string name = in.text(attribute);
+  const auto it = named.find(name);
+  if (it == named.end())
+    in.fail(std::string("attribute '") + attribute + "': no " + kinds + " named '" + name + "' " + declaredWhere);
+  return it->second;
+}
+
+}  // namespace
+
 void SceneBuild::allocate(const Layout& assigned) {
   layout = assigned;
   state = Eigen::VectorXd::Zero(layout.total());
@@ -65,12 +81,7 @@ std::string SceneBuild::declareName(ElementReader& in) {
 }
 
 Endpoint SceneBuild::endpoint(ElementReader& in, const char* attribute) const {
-  const std::string name = in.text(attribute);
-  const auto it = points.find(name);
-  if (it == points.end())
-    in.fail(std::string("attribute '") + attribute + "': no mass or anchor named '" + name +
-            "' declared above this element");
-  return it->second;
+  return declared(points, in, attribute, "mass or anchor", "declared above this element");
 }
 
 Vec3 SceneBuild::positionOf(const Endpoint& end) const {
@@ -86,21 +97,12 @@ std::pair<Endpoint, Endpoint> SceneBuild::endpoints(ElementReader& in) {
 }
 
 const Attachment& SceneBuild::attachment(ElementReader& in, const char* attribute) const {
-  const std::string target = in.text(attribute);
-  const auto it = attachments.find(target);
-  if (it == attachments.end())
-    in.fail(std::string("attribute '") + attribute + "': no body, mass or anchor named '" + target +
-            "' declared above this element");
-  return it->second;
+  return declared(attachments, in, attribute, "body, mass or anchor", "declared above this element");
 }
 
 ThermalNodeRef SceneBuild::thermalNode(ElementReader& in, const char* attribute) const {
-  const std::string name = in.text(attribute);
-  const auto it = thermalNodes.find(name);
-  if (it == thermalNodes.end())
-    in.fail(std::string("attribute '") + attribute + "': no thermal node named '" + name +
-            "' declared above (thermo_spring, thermo_maxwell, reservoir or fixed_temperature)");
-  return it->second;
+  return declared(thermalNodes, in, attribute, "thermal node",
+                  "declared above (thermo_spring, thermo_maxwell, reservoir or fixed_temperature)");
 }
 
 int SceneBuild::addThermalNode(const std::string& name, int dof, double dofScale) {
