@@ -38,17 +38,19 @@ inline std::string schemeName(Scheme scheme) {
 
 // Everything a run reports, step by step.
 struct History {
-  std::vector<double> time, energy, entropy, dissipated, externalWork, boundaryHeat;
+  std::vector<double> time, dt, energy, entropy, dissipated, externalWork, boundaryHeat;
   std::vector<Vec3> momentum, angularMomentum;
   std::vector<Eigen::VectorXd> states;
   RunSummary summary;
 };
 
-inline History run(const Model& model, Scheme scheme, double dt, double tEnd, NewtonSettings newton = {}) {
+// The history of a run made by `runWith(sink)`.
+template <class Runner>
+History collect(Runner runWith) {
   History h;
-  RunOptions options{scheme, dt, tEnd, newton};
-  h.summary = simulate(model, options, [&](const StepRecord& r) {
+  h.summary = runWith([&](const StepRecord& r) {
     h.time.push_back(r.time);
+    h.dt.push_back(r.dt);
     h.energy.push_back(r.measures->energy);
     h.entropy.push_back(r.measures->entropy);
     h.dissipated.push_back(r.crossed.dissipated);
@@ -59,6 +61,10 @@ inline History run(const Model& model, Scheme scheme, double dt, double tEnd, Ne
     h.states.push_back(*r.state);
   });
   return h;
+}
+
+inline History run(const Model& model, Scheme scheme, double dt, double tEnd, NewtonSettings newton = {}) {
+  return collect([&](const StepSink& sink) { return simulate(model, {scheme, dt, tEnd, newton}, sink); });
 }
 
 // Conservation checks computed from a history (not taken from the engine's own summary).

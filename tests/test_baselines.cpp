@@ -15,17 +15,13 @@ namespace {
 constexpr double kEndTime = 2.0;
 
 History runIda(const Model& model, double rtol, double tEnd = kEndTime) {
-  History h;
   MethodParameters parameters;
   parameters.dt = tEnd / 20;
   parameters.tEnd = tEnd;
   parameters.relativeTolerance = rtol;
   parameters.absoluteTolerance = rtol;
-  h.summary = runMethod(model, *methodByName("ida"), parameters, [&](const StepRecord& r) {
-    h.time.push_back(r.time);
-    h.energy.push_back(r.measures->energy);
-    h.states.push_back(*r.state);
-  });
+  const History h =
+      collect([&](const StepSink& sink) { return runMethod(model, *methodByName("ida"), parameters, sink); });
   EXPECT_FALSE(h.summary.failed) << h.summary.failure;
   return h;
 }

@@ -16,9 +16,10 @@ struct RunRequest {
   std::optional<double> dt, tEnd;
   std::string out;                      // empty: a directory under out/ named after the scene
   std::optional<double> frameInterval;  // bodies.csv and joints.csv rows; empty: every step
+  bool adaptive = false;                // one-step schemes; also when the scene says so
+  // IDA and adaptive steps; empty: the scene's
+  std::optional<double> relativeTolerance, absoluteTolerance;
   // IDA only
-  double relativeTolerance = 1e-6;
-  std::optional<double> absoluteTolerance;  // empty: relativeTolerance
   int maxOrder = 5;
   std::optional<double> outputStep;
 };

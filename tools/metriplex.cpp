@@ -28,6 +28,18 @@ void addSceneOptions(CLI::App* command, RunRequest& request) {
   command->add_option("--t-end", request.tEnd, "end time (default: the scene's simulation t_end)");
 }
 
+// Adaptive steps of the one-step integrators and the tolerances they share with IDA.
+void addToleranceOptions(CLI::App* command, RunRequest& request) {
+  command->add_flag("--adaptive", request.adaptive,
+                    "eem, midpoint, trapezoidal: adaptive steps to --rtol/--atol, --dt the first step (default: the "
+                    "scene's simulation adaptive)");
+  command->add_option("--rtol", request.relativeTolerance,
+                      "ida and adaptive steps: relative tolerance (default: the scene's simulation rtol, 1e-6)");
+  command->add_option("--atol", request.absoluteTolerance,
+                      "ida and adaptive steps: absolute tolerance, times each dof's scale (default: the scene's atol, "
+                      "else --rtol)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -46,9 +58,7 @@ int main(int argc, char** argv) {
                   "(default: the scene's simulation integrator)");
   run->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
-  run->add_option("--rtol", request.relativeTolerance, "ida: relative tolerance")->capture_default_str();
-  run->add_option("--atol", request.absoluteTolerance,
-                  "ida: absolute tolerance, times each dof's scale (default: --rtol)");
+  addToleranceOptions(run, request);
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   run->add_option("--output-interval", request.frameInterval,
@@ -60,6 +70,7 @@ int main(int argc, char** argv) {
   addSceneOptions(compare, request);
   compare->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   compare->add_option("--integrators", integrators, "comma-separated integrators")->capture_default_str();
+  addToleranceOptions(compare, request);
   compare->add_option("--out", request.out, "output directory (default: out/<scene name>-compare)");
 
   BenchRequest bench;

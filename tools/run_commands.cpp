@@ -73,8 +73,12 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.dt = request.dt.value_or(scene.settings.dt);
   parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
   parameters.newton = scene.settings.newton;
-  parameters.relativeTolerance = request.relativeTolerance;
-  parameters.absoluteTolerance = request.absoluteTolerance.value_or(request.relativeTolerance);
+  parameters.adaptive = request.adaptive || scene.settings.adaptive;
+  const double sceneAtol = scene.settings.absoluteTolerance;
+  parameters.relativeTolerance = request.relativeTolerance.value_or(scene.settings.relativeTolerance);
+  parameters.absoluteTolerance = request.absoluteTolerance.value_or(
+      request.relativeTolerance || sceneAtol == 0.0 ? parameters.relativeTolerance : sceneAtol);
+  parameters.outputInterval = request.frameInterval.value_or(0.0);
   parameters.maxOrder = request.maxOrder;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
@@ -106,9 +110,10 @@ RunResult execute(const PreparedRun& run) {
 
 double perStep(long count, int steps) { return steps ? static_cast<double>(count) / steps : 0.0; }
 
-void printSummary(const RunResult& r, const RunRequest& request, const Method& method) {
+void printSummary(const RunResult& r, const RunRequest& request, const PreparedRun& run) {
   const RunSummary& s = r.summary;
-  fmt::print("metriplex run {} --integrator {} (thermal variable: {})\n", request.scene, method.name, r.variable);
+  fmt::print("metriplex run {} --integrator {}{} (thermal variable: {})\n", request.scene, run.method.name,
+             run.parameters.adaptive && !run.method.isIda() ? " --adaptive" : "", r.variable);
   fmt::print("  steps                    {}{}\n", s.steps, s.ida ? " (output times)" : "");
   fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations,
              perStep(s.newtonIterations, s.steps));
@@ -119,6 +124,7 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
         s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
         s.ida->errorTestFailures, s.ida->convergenceFailures);
   else {
+    if (run.parameters.adaptive) fmt::print("  rejected steps           {}\n", s.rejectedSteps);
     fmt::print("  cut-backs                {}\n", s.cutbacks);
     fmt::print("  linear system            {}\n", s.linearSystem);
   }
@@ -135,7 +141,7 @@ void printSummary(const RunResult& r, const RunRequest& request, const Method& m
 int runCommand(const RunRequest& request) {
   const PreparedRun run = prepare(request, request.integrator.empty() ? "run" : request.integrator);
   const RunResult result = execute(run);
-  printSummary(result, request, run.method);
+  printSummary(result, request, run);
   if (!result.summary.failed) return 0;
   fmt::print(stderr,
              "metriplex: solver failure at step {} (t = {:.9g}): {}; history kept up to the last good step in {}\n",

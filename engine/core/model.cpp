@@ -6,14 +6,17 @@ namespace mpx {
 
 Model::Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
              std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
-             std::vector<PrescribedMotion> prescribedMotions)
+             std::vector<PrescribedMotion> prescribedMotions, std::vector<double> loadBreakpoints)
     : layout_(layout),
       thermalVariable_(thermalVariable),
       components_(std::move(components)),
       thermalNodeNames_(std::move(thermalNodeNames)),
       initialState_(std::move(initialState)),
       dofScale_(std::move(dofScale)),
-      prescribedMotions_(std::move(prescribedMotions)) {
+      prescribedMotions_(std::move(prescribedMotions)),
+      loadBreakpoints_(std::move(loadBreakpoints)) {
+  std::sort(loadBreakpoints_.begin(), loadBreakpoints_.end());
+  loadBreakpoints_.erase(std::unique(loadBreakpoints_.begin(), loadBreakpoints_.end()), loadBreakpoints_.end());
   // couplings read what the others publish: evaluate them last
   std::stable_partition(components_.begin(), components_.end(),
                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); });

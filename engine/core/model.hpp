@@ -33,7 +33,7 @@ class Model {
  public:
   Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::unique_ptr<Component>> components,
         std::vector<std::string> thermalNodeNames, Eigen::VectorXd initialState, Eigen::VectorXd dofScale,
-        std::vector<PrescribedMotion> prescribedMotions = {});
+        std::vector<PrescribedMotion> prescribedMotions = {}, std::vector<double> loadBreakpoints = {});
 
   const Layout& layout() const { return layout_; }
   ThermalVariable thermalVariable() const { return thermalVariable_; }
@@ -44,6 +44,8 @@ class Model {
   // Characteristic magnitude of each dof, used to weigh Newton increments.
   const Eigen::VectorXd& dofScale() const { return dofScale_; }
   const std::vector<PrescribedMotion>& prescribedMotions() const { return prescribedMotions_; }
+  // Times where a load or prescribed motion has a kink, increasing and distinct.
+  const std::vector<double>& loadBreakpoints() const { return loadBreakpoints_; }
 
   // Energy, entropy, momenta and node temperatures of state z; `out` is reused (no allocation
   // once sized).
@@ -58,6 +60,7 @@ class Model {
   Eigen::VectorXd initialState_;
   Eigen::VectorXd dofScale_;
   std::vector<PrescribedMotion> prescribedMotions_;
+  std::vector<double> loadBreakpoints_;
 };
 
 }  // namespace mpx

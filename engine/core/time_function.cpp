@@ -82,4 +82,20 @@ double TimeFunction::slope(double t) const {
   return 0.0;
 }
 
+std::vector<double> TimeFunction::breakpoints() const {
+  switch (kind_) {
+    case Kind::Constant:
+      return {};
+    case Kind::Ramp:
+      return {a_, b_};
+    case Kind::Hat:
+      return {0.5 * a_, a_};
+    case Kind::SinePulse:
+      return {0.0, a_};
+    case Kind::Table:
+      return times_;
+  }
+  return {};
+}
+
 }  // namespace mpx

@@ -20,6 +20,8 @@ class TimeFunction {
   double operator()(double t) const;
   // df/dt (the right derivative at kinks).
   double slope(double t) const;
+  // The times where f or df/dt is not smooth, increasing; adaptive steps land on them.
+  std::vector<double> breakpoints() const;
 
  private:
   enum class Kind { Constant, Ramp, Hat, SinePulse, Table };

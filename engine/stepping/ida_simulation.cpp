@@ -47,6 +47,7 @@ class IdaProblem {
   Flows crossed() const;
   const std::string& error() const { return error_; }
   IdaStatistics statistics() const;
+  double lastStep() const;
 
  private:
   static int residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* self);
@@ -247,6 +248,12 @@ bool IdaProblem::advanceTo(double tout) {
   return IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0 && IDAGetQuad(ida_, &reached, crossed_) >= 0;
 }
 
+double IdaProblem::lastStep() const {
+  realtype step = 0.0;
+  IDAGetLastStep(ida_, &step);
+  return step;
+}
+
 IdaStatistics IdaProblem::statistics() const {
   IdaStatistics s;
   IDAGetNumSteps(ida_, &s.steps);
@@ -266,7 +273,7 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
   IdaProblem ida(model, options);
   const int n = model.layout().total();
   const auto outputs = static_cast<int>(std::ceil(options.tEnd / options.outputStep - 1e-9));
-  RunReporter reporter(model, summary, sink, progress, outputs);
+  RunReporter reporter(model, summary, sink, progress, options.tEnd);
   auto fail = [&](int output, double t, const std::string& what) {
     summary.failed = true;
     summary.failedStep = output;
@@ -285,7 +292,8 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
     }
     reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
     const IdaStatistics stats = ida.statistics();
-    reporter.report(k, tout, ida.crossed(), static_cast<int>(stats.nonlinearIterations - previousIterations),
+    reporter.report(k, tout, ida.lastStep(), ida.crossed(),
+                    static_cast<int>(stats.nonlinearIterations - previousIterations),
                     static_cast<int>(stats.errorTestFailures - previousErrorTestFailures));
     previousIterations = stats.nonlinearIterations;
     previousErrorTestFailures = stats.errorTestFailures;

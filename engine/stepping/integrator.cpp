@@ -140,7 +140,8 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
                               StepOutcome& outcome) {
   // the first attempt of a step that continues the last one starts from the extrapolation;
   // if Newton fails from there, it tries again from the old state before cutting back
-  const bool continues = level == 0 && settings_.predictor && t == lastTime_ + lastDt_ && z == lastEnd_;
+  const bool continues = level == 0 && settings_.predictor &&
+                         std::abs(t - (lastTime_ + lastDt_)) <= 1e-12 * (std::abs(t) + lastDt_) && z == lastEnd_;
   if (continues) {
     zNew = z + (dt / lastDt_) * (lastEnd_ - lastStart_);
     if (solveStep(z, t, dt, zNew, outcome)) return true;

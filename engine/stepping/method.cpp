@@ -27,7 +27,11 @@ RunSummary runMethod(const Model& model, const Method& method, const MethodParam
                      const ProgressSink& progress) {
   if (method.isIda())
     return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.dt, p.tEnd}, sink, progress);
-  return simulate(model, {*method.scheme, p.dt, p.tEnd, p.newton}, sink, progress);
+  const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton};
+  if (p.adaptive)
+    return simulateAdaptive(model, options, {p.relativeTolerance, p.absoluteTolerance, p.outputInterval}, sink,
+                            progress);
+  return simulate(model, options, sink, progress);
 }
 
 }  // namespace mpx

@@ -2,6 +2,7 @@
 // Integration methods by name, and one entry point that runs any of them on a model:
 // EEM (with the scene's or a forced thermal variable), implicit midpoint, trapezoidal, IDA.
 #include "engine/core/model.hpp"
+#include "engine/stepping/adaptive_simulation.hpp"
 #include "engine/stepping/ida_simulation.hpp"
 #include "engine/stepping/simulation.hpp"
 
@@ -22,11 +23,13 @@ inline constexpr const char* kMethodNames = "eem, eem-entropy, eem-temperature, 
 std::optional<Method> methodByName(const std::string& name);
 
 struct MethodParameters {
-  double dt = 0.0;  // step of one-step schemes; IDA's output interval
+  double dt = 0.0;  // step of one-step schemes (adaptive: the first); IDA's output interval
   double tEnd = 0.0;
   NewtonSettings newton;
-  double relativeTolerance = 1e-6;  // IDA
-  double absoluteTolerance = 1e-6;  // IDA, times each dof's scale
+  bool adaptive = false;            // one-step schemes: adaptive steps
+  double relativeTolerance = 1e-6;  // IDA and adaptive steps
+  double absoluteTolerance = 1e-6;  // IDA and adaptive steps, times each dof's scale
+  double outputInterval = 0.0;      // adaptive steps land on its multiples
   int maxOrder = 5;                 // IDA
 };
 

@@ -4,13 +4,13 @@
 
 namespace mpx {
 
-RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps)
+RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd)
     : model_(model),
       summary_(summary),
       sink_(std::move(sink)),
       progress_(std::move(progress)),
-      steps_(steps),
-      progressEvery_(std::max(1, steps / 100)),
+      tEnd_(tEnd),
+      nextProgress_(0.01 * tEnd),
       state_(model.initialState()),
       start_(std::chrono::steady_clock::now()) {
   model_.measure(state_, measures_);
@@ -21,10 +21,11 @@ RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink,
   sink_(record_);
 }
 
-void RunReporter::report(int step, double time, const Flows& crossed, int newtonIterations, int cutbacks) {
+void RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks) {
   model_.measure(state_, measures_);
   record_.step = step;
   record_.time = time;
+  record_.dt = dt;
   record_.crossed = crossed;
   record_.newtonIterations = newtonIterations;
   record_.cutbacks = cutbacks;
@@ -39,7 +40,11 @@ void RunReporter::report(int step, double time, const Flows& crossed, int newton
       step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
   previousEntropy_ = measures_.entropy;
   summary_.steps = step;
-  if (progress_ && step % progressEvery_ == 0) progress_(static_cast<double>(step) / steps_);
+  // at most about a hundred progress reports
+  if (progress_ && time >= nextProgress_) {
+    progress_(std::min(1.0, time / tEnd_));
+    nextProgress_ = time + 0.01 * tEnd_;
+  }
 }
 
 void RunReporter::finish() {
@@ -52,7 +57,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
   summary.linearSystem = integrator.linearSolver().describe();
   // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
   const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
-  RunReporter reporter(model, summary, sink, progress, steps);
+  RunReporter reporter(model, summary, sink, progress, options.tEnd);
   Eigen::VectorXd next(reporter.state().size());
   Flows crossed;
   for (int n = 1; n <= steps; ++n) {
@@ -71,7 +76,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     }
     reporter.state().swap(next);
     crossed += outcome.energy;
-    reporter.report(n, n == steps ? options.tEnd : t + dt, crossed, outcome.iterations, outcome.cutbacks);
+    reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks);
   }
   reporter.finish();
   return summary;

@@ -1,6 +1,7 @@
 #pragma once
 // The time loop: advance a model with one integrator at a fixed step, report every step to a
-// sink, and summarise the run (cost, conservation, failure).
+// sink, and summarise the run (cost, conservation, failure). Adaptive steps:
+// engine/stepping/adaptive_simulation.hpp.
 #include "engine/stepping/integrator.hpp"
 
 #include <algorithm>
@@ -14,7 +15,7 @@ namespace mpx {
 
 struct RunOptions {
   Scheme scheme = Scheme::Eem;
-  double dt = 0.0;
+  double dt = 0.0;  // the step (the first step of an adaptive run)
   double tEnd = 0.0;
   NewtonSettings newton;
 };
@@ -23,6 +24,7 @@ struct RunOptions {
 struct StepRecord {
   int step = 0;
   double time = 0.0;
+  double dt = 0.0;  // of the step that ended here (IDA: its last internal step)
   const Eigen::VectorXd* state = nullptr;
   const Measures* measures = nullptr;
   Flows crossed;
@@ -66,6 +68,7 @@ struct RunSummary {
   long newtonIterations = 0;
   long factorizations = 0;  // of the step tangent (one-step schemes)
   int cutbacks = 0;
+  int rejectedSteps = 0;  // by the error test of adaptive steps
   double wallSeconds = 0.0;
   // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy seen (EnergyBalance):
   // energy drift net of dissipated energy D, external work W and boundary heat Q (the plain
@@ -89,13 +92,14 @@ using ProgressSink = std::function<void(double)>;
 // wall time; the progress bar. Constructing it reports the initial state as step 0.
 class RunReporter {
  public:
-  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, int steps);
+  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd);
 
   // The state the next report() describes; loops advance it in place.
   Eigen::VectorXd& state() { return state_; }
   const StepRecord& last() const { return record_; }
-  // Report state() as `step` at `time`; `crossed` holds the energies crossed since t = 0.
-  void report(int step, double time, const Flows& crossed, int newtonIterations, int cutbacks);
+  // Report state() as `step` at `time`, reached by a step of `dt`; `crossed` holds the
+  // energies crossed since t = 0.
+  void report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();
 
@@ -104,7 +108,7 @@ class RunReporter {
   RunSummary& summary_;
   StepSink sink_;
   ProgressSink progress_;
-  int steps_, progressEvery_;
+  double tEnd_, nextProgress_;
   Eigen::VectorXd state_;
   Measures measures_;
   StepRecord record_;

@@ -68,7 +68,8 @@ void buildForce(ElementReader& in, SceneBuild& build, DofRange&) {
   const Endpoint on = build.endpoint(in, "on");
   if (!on.isMass()) in.fail("attribute 'on' must name a mass or a body (its centre of mass), not an anchor");
   const Vec3 force = in.vector("force", Vec3::Zero());
-  build.addComponent(std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, readProfile(in)));
+  build.addComponent(
+      std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, readProfile(in, build)));
 }
 
 }  // namespace

@@ -177,7 +177,7 @@ void buildTorque(ElementReader& in, SceneBuild& build, DofRange&) {
     in.fail("attribute 'on': no body named '" + target + "' declared above this element");
   const Vec3 torque = in.vector("torque", Vec3::Zero());
   build.addComponent(std::make_unique<ExternalTorque>(name, body->second.firstPositionDof + 3, build.velocityShift(),
-                                                      torque, readProfile(in)));
+                                                      torque, readProfile(in, build)));
 }
 
 }  // namespace

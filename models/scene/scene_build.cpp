@@ -189,7 +189,9 @@ std::string elementTags() {
   return tags;
 }
 
-TimeFunction readProfile(ElementReader& in) {
+namespace {
+
+TimeFunction parseProfile(ElementReader& in) {
   const std::string profile = in.text("profile", "constant");
   if (profile == "constant") return TimeFunction::constant();
   if (profile == "ramp") {
@@ -208,6 +210,15 @@ TimeFunction readProfile(ElementReader& in) {
     return TimeFunction::table(std::move(times), std::move(values));
   }
   in.fail("profile must be constant, ramp, hat, sine_pulse or table, got '" + profile + "'");
+}
+
+}  // namespace
+
+TimeFunction readProfile(ElementReader& in, SceneBuild& build) {
+  const TimeFunction profile = parseProfile(in);
+  const std::vector<double> breakpoints = profile.breakpoints();
+  build.loadBreakpoints.insert(build.loadBreakpoints.end(), breakpoints.begin(), breakpoints.end());
+  return profile;
 }
 
 }  // namespace mpx

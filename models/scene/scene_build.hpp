@@ -101,7 +101,8 @@ class SceneBuild {
   std::vector<JointCoordinate> jointCoordinates;
   std::vector<SolidPlacement> solids;
   std::vector<PrescribedMotion> prescribedMotions;
-  double positionScale = 0.0;  // the largest length seen, for Newton's position scale
+  std::vector<double> loadBreakpoints;  // of every load profile read
+  double positionScale = 0.0;           // the largest length seen, for Newton's position scale
 
   void allocate(const Layout& assigned);
   int velocityShift() const { return layout.offset(Block::Velocity) - layout.offset(Block::Position); }
@@ -161,6 +162,7 @@ const ElementKind* findElementKind(const std::string& tag);
 std::string elementTags();
 
 // The time function of a load: profile="constant|ramp|hat|sine_pulse|table" and its parameters.
-TimeFunction readProfile(ElementReader& in);
+// Its breakpoints join the build's, where adaptive steps land.
+TimeFunction readProfile(ElementReader& in, SceneBuild& build);
 
 }  // namespace mpx

@@ -27,6 +27,9 @@ void checkSettings(const SceneSpec& scene) {
   require(s.dt > 0.0 && std::isfinite(s.dt) && s.tEnd > 0.0 && std::isfinite(s.tEnd),
           "the simulation needs finite dt > 0 and t_end > 0");
   require(methodByName(s.integrator).has_value(), "unknown integrator '" + s.integrator + "'");
+  require(s.relativeTolerance > 0.0 && std::isfinite(s.relativeTolerance) && s.absoluteTolerance >= 0.0 &&
+              std::isfinite(s.absoluteTolerance),
+          "rtol must be positive and atol non-negative");
   require(n.incrementTolerance > 0.0 && n.residualTolerance > 0.0, "Newton tolerances must be positive");
   require(n.maxIterations >= 1 && n.maxCutbacks >= 0, "max_iterations must be at least 1, max_cutbacks at least 0");
   require(n.reuseContraction >= 0.0 && n.reuseContraction < 1.0, "reuse_contraction must be in [0, 1)");
@@ -90,9 +93,9 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
                      ": <metriplex>: the scene has nothing to integrate (no mass, body, solid, thermal element "
                      "or reservoir)");
   setMechanicalScales(build, scene.settings.tEnd);
-  auto model =
-      std::make_unique<Model>(build.layout, build.variable, std::move(build.components), build.thermalNodeNames,
-                              build.state, build.scale, std::move(build.prescribedMotions));
+  auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
+                                       build.thermalNodeNames, build.state, build.scale,
+                                       std::move(build.prescribedMotions), std::move(build.loadBreakpoints));
   return {scene.name,
           scene.settings,
           std::move(model),

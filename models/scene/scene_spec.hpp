@@ -81,6 +81,11 @@ struct SceneSettings {
   ThermalVariable thermalVariable = ThermalVariable::Temperature;  // what the scene declares
   DiscreteGradientForm discreteGradient = DiscreteGradientForm::Partitioned;
   NewtonSettings newton;
+  // adaptive steps of the one-step integrators (dt is then the first step) and their
+  // tolerances, which IDA uses too; absoluteTolerance 0: relativeTolerance
+  bool adaptive = false;
+  double relativeTolerance = 1e-6;
+  double absoluteTolerance = 0.0;
 };
 
 struct SceneSpec {

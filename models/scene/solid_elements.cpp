@@ -221,7 +221,7 @@ void buildTraction(ElementReader& in, SceneBuild& build, DofRange&) {
       in.has("traction") ? in.vector("traction", Vec3::Zero()) : in.vector("total_force", Vec3::Zero()) / area;
   std::map<int, Vec3> forces;
   for (const auto& [node, share] : nodeArea) forces[node] = share * traction;
-  addNodalForces(build, name, solid, forces, readProfile(in));
+  addNodalForces(build, name, solid, forces, readProfile(in, build));
 }
 
 void buildBodyForce(ElementReader& in, SceneBuild& build, DofRange&) {
@@ -236,7 +236,7 @@ void buildBodyForce(ElementReader& in, SceneBuild& build, DofRange&) {
         auto [it, inserted] = forces.emplace(cell.nodes[a], Vec3::Zero());
         it->second += p.weight * p.values[a] * density;
       }
-  addNodalForces(build, name, solid, forces, readProfile(in));
+  addNodalForces(build, name, solid, forces, readProfile(in, build));
 }
 
 enum class MotionKind { Clamp, Velocity, Displacement };
@@ -249,7 +249,7 @@ void buildPrescribedMotion(ElementReader& in, SceneBuild& build, MotionKind kind
     in.fail("directions must be letters from 'xyz', got '" + directions + "'");
   const bool clamp = kind == MotionKind::Clamp, displacement = kind == MotionKind::Displacement;
   const Vec3 amplitude = clamp ? Vec3::Zero() : in.vector(displacement ? "displacement" : "velocity", Vec3::Zero());
-  const TimeFunction profile = clamp ? TimeFunction::constant(0.0) : readProfile(in);
+  const TimeFunction profile = clamp ? TimeFunction::constant(0.0) : readProfile(in, build);
   // the initial velocity that the motion starts with
   const Vec3 startVelocity = amplitude * (displacement ? profile.slope(0.0) : profile(0.0));
   std::vector<PrescribedMotion>& motions = build.prescribedMotions;

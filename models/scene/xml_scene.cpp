@@ -44,6 +44,9 @@ void readSimulation(ElementReader& in, SceneSettings& settings) {
   if (form != "partitioned" && form != "gonzalez")
     in.fail("discrete_gradient must be 'partitioned' or 'gonzalez', got '" + form + "'");
   settings.discreteGradient = form == "gonzalez" ? DiscreteGradientForm::Gonzalez : DiscreteGradientForm::Partitioned;
+  settings.adaptive = in.flag("adaptive", false);
+  settings.relativeTolerance = in.positive("rtol", settings.relativeTolerance);
+  settings.absoluteTolerance = in.has("atol") ? in.positive("atol") : 0.0;
 }
 
 void readSolver(ElementReader& in, NewtonSettings& n) {

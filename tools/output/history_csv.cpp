@@ -11,7 +11,7 @@ HistoryCsv::HistoryCsv(const std::filesystem::path& directory, const Model& mode
   file_ = std::fopen(partPath_.c_str(), "w");
   if (!file_) throw InputError(partPath_.string() + ": cannot create the output file");
   std::string header =
-      "time,energy,entropy,dissipated_energy,external_work,boundary_heat,momentum_x,momentum_y,momentum_z,"
+      "time,dt,energy,entropy,dissipated_energy,external_work,boundary_heat,momentum_x,momentum_y,momentum_z,"
       "angular_momentum_x,angular_momentum_y,angular_momentum_z,newton_iterations,cutbacks,constraint_violation";
   for (const std::string& node : model.thermalNodeNames()) header += ",temperature_" + node;
   fmt::print(file_, "{}\n", header);
@@ -25,10 +25,11 @@ void HistoryCsv::write(const StepRecord& r) {
   const Measures& m = *r.measures;
   fmt::print(
       file_,
-      "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{:.17g}",
-      r.time, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat, m.momentum.x(),
-      m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
-      r.newtonIterations, r.cutbacks, m.constraintViolation);
+      "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},"
+      "{:.17g}",
+      r.time, r.dt, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat,
+      m.momentum.x(), m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(),
+      m.angularMomentum.z(), r.newtonIterations, r.cutbacks, m.constraintViolation);
   for (double temperature : m.nodeTemperature) fmt::print(file_, ",{:.17g}", temperature);
   std::fputc('\n', file_);
 }

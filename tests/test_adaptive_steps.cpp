@@ -1,0 +1,127 @@
+// Adaptive steps of the one-step schemes: every accepted step keeps the scheme's balances
+// (energy, entropy, momenta), steps land exactly on load breakpoints and output times, and the
+// error against an independent reference (IDA at rtol 1e-11) falls with the tolerance at the
+// rate a second-order scheme under error-per-step control gives (error ~ rtol^(2/3)).
+#include "support.hpp"
+
+#include "engine/stepping/adaptive_simulation.hpp"
+#include "engine/stepping/method.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace mpx::test {
+namespace {
+
+History runAdaptive(const Model& model, Scheme scheme, double rtol, double tEnd, double firstStep = 0.1,
+                    double outputInterval = 0.0) {
+  const History h = collect([&](const StepSink& sink) {
+    return simulateAdaptive(model, {scheme, firstStep, tEnd, {}}, {rtol, rtol, outputInterval}, sink);
+  });
+  EXPECT_FALSE(h.summary.failed) << h.summary.failure;
+  return h;
+}
+
+Eigen::VectorXd idaFinalState(const Model& model, double tEnd) {
+  MethodParameters parameters;
+  parameters.dt = tEnd;
+  parameters.tEnd = tEnd;
+  parameters.relativeTolerance = parameters.absoluteTolerance = 1e-11;
+  const History h =
+      collect([&](const StepSink& sink) { return runMethod(model, *methodByName("ida"), parameters, sink); });
+  EXPECT_FALSE(h.summary.failed) << h.summary.failure;
+  return h.states.back();
+}
+
+// least-squares slope of log(y) against log(x)
+double logSlope(const std::vector<double>& x, const std::vector<double>& y) {
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += std::log(x[i]) / x.size(), my += std::log(y[i]) / x.size();
+  double sxy = 0, sxx = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxy += (std::log(x[i]) - mx) * (std::log(y[i]) - my);
+    sxx += (std::log(x[i]) - mx) * (std::log(x[i]) - mx);
+  }
+  return sxy / sxx;
+}
+
+struct Case {
+  const char* scene;
+  Scheme scheme;
+  bool keepsAngularMomentum;  // the model is invariant under rotations
+  double finestError;         // the bound at rtol 1e-7
+};
+
+class AdaptiveSteps : public ::testing::TestWithParam<Case> {};
+
+// E (net of what crossed the boundary), the entropy and, where the model is invariant, the
+// angular momentum behave at every accepted EEM step as at fixed steps, with steps of many
+// sizes (a first step of 1, far too large, is rejected and shrunk)
+TEST_P(AdaptiveSteps, KeepTheBalancesAtEveryAcceptedStep) {
+  const CompiledScene scene = loadScene(scenePath(GetParam().scene));
+  const History h = runAdaptive(*scene.model, GetParam().scheme, 1e-5, 20.0, 1.0);
+  const auto [shortest, longest] = std::minmax_element(h.dt.begin() + 1, h.dt.end());
+  std::printf("%s, %s: %zu steps from %.3g to %.3g, %d rejected; energy drift %.2e, angular momentum drift %.2e\n",
+              GetParam().scene, schemeName(GetParam().scheme).c_str(), h.dt.size() - 1, *shortest, *longest,
+              h.summary.rejectedSteps, relativeBalanceDrift(h),
+              (h.angularMomentum.back() - h.angularMomentum.front()).norm());
+  EXPECT_GT(*longest, 3.0 * *shortest);
+  EXPECT_GT(h.summary.rejectedSteps, 0);
+  if (GetParam().scheme != Scheme::Eem) return;  // the standard schemes keep neither E nor S
+  EXPECT_LT(relativeBalanceDrift(h), 1e-11);
+  EXPECT_EQ(firstEntropyDecrease(h), -1);
+  if (!GetParam().keepsAngularMomentum) return;
+  for (const Vec3& j : h.angularMomentum) EXPECT_LT((j - h.angularMomentum.front()).norm(), 1e-13);
+}
+
+// The global error at t_end against IDA at rtol 1e-11 (positions, velocities, thermal and
+// internal variables; multipliers differ by formulation) shrinks as rtol^(2/3)
+TEST_P(AdaptiveSteps, ErrorScalesWithTheTolerance) {
+  constexpr double kEndTime = 2.0;
+  const CompiledScene scene = loadScene(scenePath(GetParam().scene));
+  const Eigen::VectorXd reference = idaFinalState(*scene.model, kEndTime);
+  const std::vector<double> tolerances = {1e-4, 1e-5, 1e-6, 1e-7};
+  std::vector<double> errors;
+  std::printf("%s, %s: error at t = %g by rtol:", GetParam().scene, schemeName(GetParam().scheme).c_str(), kEndTime);
+  for (double rtol : tolerances) {
+    const History h = runAdaptive(*scene.model, GetParam().scheme, rtol, kEndTime);
+    const Eigen::Index compared = scene.model->layout().offset(Block::Multiplier);
+    errors.push_back((h.states.back() - reference).head(compared).lpNorm<Eigen::Infinity>());
+    std::printf(" %.0e: %.3e (%zu steps)", rtol, errors.back(), h.dt.size() - 1);
+  }
+  const double slope = logSlope(tolerances, errors);
+  std::printf("; slope %.3f\n", slope);
+  EXPECT_NEAR(slope, 2.0 / 3.0, 0.15);
+  for (std::size_t k = 1; k < errors.size(); ++k) EXPECT_LT(errors[k], errors[k - 1]);
+  EXPECT_LT(errors.back(), GetParam().finestError);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, AdaptiveSteps,
+                         ::testing::Values(Case{"two_thermo_springs.xml", Scheme::Eem, true, 2e-4},
+                                           Case{"two_thermo_springs.xml", Scheme::Midpoint, true, 2e-4},
+                                           Case{"two_thermo_springs.xml", Scheme::Trapezoidal, true, 2e-4},
+                                           Case{"double_pendulum.xml", Scheme::Eem, false, 5e-3}));
+
+// A mass on a spring pushed by a hat load (kinks at 0.35 and 0.7) with output every 0.25:
+// every breakpoint and output time is a step end, bit for bit, and the work the load did
+// balances the energy at every step
+TEST(AdaptiveLandings, StepsLandOnBreakpointsAndOutputTimes) {
+  SceneSpec spec;
+  spec.settings.dt = 0.05;
+  spec.settings.tEnd = 1.6;
+  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
+  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
+  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
+  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0.5, 0)}, {"profile", "hat"}, {"period", 0.7}});
+  const CompiledScene scene = compileScene(spec);
+  EXPECT_EQ(scene.model->loadBreakpoints(), (std::vector<double>{0.35, 0.7}));
+  const History h = runAdaptive(*scene.model, Scheme::Eem, 1e-6, 1.6, 0.05, 0.25);
+  for (double landing : {0.25, 0.35, 0.5, 0.7, 0.75, 1.0, 1.25, 1.5, 1.6})
+    EXPECT_NE(std::find(h.time.begin(), h.time.end(), landing), h.time.end()) << "no step ends at " << landing;
+  EXPECT_GT(h.externalWork.back(), 0.0);
+  EXPECT_LT(maxBalanceDrift(h), 1e-12 * largestEnergy(h));
+}
+
+}  // namespace
+}  // namespace mpx::test
