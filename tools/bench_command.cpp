@@ -1,5 +1,7 @@
 // metriplex bench: a work-precision sweep of one scene. One-step schemes over a list of steps,
-// IDA over a list of tolerances, each against one cached reference solution (IDA at rtol 1e-12).
+// IDA and adaptive one-step schemes over a list of tolerances, each against one cached
+// reference solution (IDA at rtol 1e-12): positions and temperatures at t_end, and the energy
+// at the end of loading (the last load breakpoint before t_end).
 #include "tools/commands.hpp"
 #include "tools/output/plots.hpp"
 
@@ -24,11 +26,20 @@ namespace {
 
 constexpr double kReferenceTolerance = 1e-12;
 
-// What is compared with the reference at the final time.
+// What is compared with the reference: the final positions and temperatures, and the energy
+// when the loads end (NaN for a scene without a load breakpoint before t_end).
 struct FinalState {
   Eigen::VectorXd positions;
   std::vector<double> temperatures;
+  double loadEndEnergy = NAN;
 };
+
+// The last load breakpoint before tEnd (NaN if none): after it the loads are constant.
+double loadEnd(const Model& model, double tEnd) {
+  const std::vector<double>& kinks = model.loadBreakpoints();
+  const auto last = std::find_if(kinks.rbegin(), kinks.rend(), [&](double t) { return t > 0.0 && t < tEnd; });
+  return last == kinks.rend() ? NAN : *last;
+}
 
 struct BenchRun {
   std::string integrator;
@@ -37,7 +48,9 @@ struct BenchRun {
   RunSummary summary;
   FinalState final;
   int entropyViolations = 0;
-  double error = 0.0;
+  double error = 0.0;          // relative, positions and temperatures
+  double positionError = 0.0;  // max |x - x_ref| over the position dofs
+  double energyError = NAN;    // |E - E_ref| / |E_ref| at the end of loading
   std::string status;
   std::vector<SeriesPoint> series;
 };
@@ -63,12 +76,14 @@ double relativeError(const FinalState& run, const FinalState& reference) {
 // One run, repeated for a median CPU time; keeps the last repeat's results.
 BenchRun measure(const Model& model, const Method& method, const MethodParameters& parameters, int repeats,
                  bool keepSeries) {
+  const double loadEndTime = loadEnd(model, parameters.tEnd);
   BenchRun run;
   run.integrator = method.name;
   std::vector<double> cpu;
   for (int r = 0; r < repeats; ++r) {
     Measures last;
     Eigen::VectorXd lastState;
+    double loadEndEnergy = NAN;
     EnergyBalance balance(0.0);
     double initialEntropy = 0.0, previousEntropy = 0.0;
     run.entropyViolations = 0;
@@ -86,13 +101,21 @@ BenchRun measure(const Model& model, const Method& method, const MethodParameter
       }
       last = m;
       lastState = *record.state;
+      if (std::isnan(loadEndEnergy) && record.time >= loadEndTime - 1e-9 * parameters.tEnd) loadEndEnergy = m.energy;
     });
     cpu.push_back(static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC);
     run.final = finalStateOf(model, lastState, last);
+    run.final.loadEndEnergy = loadEndEnergy;
   }
   std::sort(cpu.begin(), cpu.end());
   run.cpuSeconds = cpu[cpu.size() / 2];
   return run;
+}
+
+// IDA's output interval: about t_end / 100, a divisor of the end of loading where there is one.
+double idaOutputStep(const Model& model, double tEnd) {
+  const double end = loadEnd(model, tEnd);
+  return std::isnan(end) ? tEnd / 100 : end / std::ceil(end / (tEnd / 100));
 }
 
 // Reference final state: computed once per scene text and end time, cached in DIR/reference.csv.
@@ -110,15 +133,16 @@ FinalState reference(const Model& model, const std::string& sceneText, double tE
       if (in.peek() == ',') in.ignore();
     }
     const Eigen::Index positions = model.layout().size(Block::Position);
-    if (values.size() == positions + model.thermalNodeNames().size()) {
+    if (values.size() == positions + model.thermalNodeNames().size() + 1) {
       cached.positions = Eigen::Map<Eigen::VectorXd>(values.data(), positions);
-      cached.temperatures.assign(values.begin() + positions, values.end());
+      cached.temperatures.assign(values.begin() + positions, values.end() - 1);
+      cached.loadEndEnergy = values.back();
       fmt::print("reference: cached in {}\n", file.string());
       return cached;
     }
   }
   MethodParameters parameters;
-  parameters.dt = tEnd / 100;
+  parameters.dt = idaOutputStep(model, tEnd);
   parameters.tEnd = tEnd;
   parameters.relativeTolerance = kReferenceTolerance;
   parameters.absoluteTolerance = kReferenceTolerance;
@@ -130,7 +154,7 @@ FinalState reference(const Model& model, const std::string& sceneText, double tE
   std::string row;
   for (double v : run.final.positions) row += fmt::format("{}{:.17g}", row.empty() ? "" : ",", v);
   for (double v : run.final.temperatures) row += fmt::format(",{:.17g}", v);
-  out.print("{}\n", row);
+  out.print("{},{:.17g}\n", row, run.final.loadEndEnergy);
   fmt::print("reference: IDA at rtol {:g} ({:.2f} s CPU), written to {}\n", kReferenceTolerance, run.cpuSeconds,
              file.string());
   return run.final;
@@ -148,14 +172,14 @@ void writeCsv(const std::filesystem::path& file, const std::vector<BenchRun>& ru
   auto out = fmt::output_file(file.string());
   out.print(
       "integrator,dt,rtol,cpu_seconds,steps,newton_iterations,ida_steps,ida_residual_evaluations,"
-      "ida_jacobian_evaluations,ida_nonlinear_iterations,ida_error_test_failures,error,energy_drift,"
-      "entropy_violations,status\n");
+      "ida_jacobian_evaluations,ida_nonlinear_iterations,ida_error_test_failures,error,position_error,"
+      "load_end_energy_error,energy_drift,entropy_violations,rejected_steps,status\n");
   for (const BenchRun& r : runs) {
     const IdaStatistics ida = r.summary.ida.value_or(IdaStatistics{});
-    out.print("{},{:g},{:g},{:.6g},{},{},{},{},{},{},{},{:.6e},{:.6e},{},{}\n", r.integrator, r.dt, r.rtol,
-              r.cpuSeconds, r.summary.steps, r.summary.newtonIterations, ida.steps, ida.residualEvaluations,
-              ida.jacobianEvaluations, ida.nonlinearIterations, ida.errorTestFailures, r.error,
-              r.summary.maxEnergyBalanceError, r.entropyViolations, r.status);
+    out.print("{},{:g},{:g},{:.6g},{},{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", r.integrator, r.dt,
+              r.rtol, r.cpuSeconds, r.summary.steps, r.summary.newtonIterations, ida.steps, ida.residualEvaluations,
+              ida.jacobianEvaluations, ida.nonlinearIterations, ida.errorTestFailures, r.error, r.positionError,
+              r.energyError, r.summary.maxEnergyBalanceError, r.entropyViolations, r.summary.rejectedSteps, r.status);
   }
 }
 
@@ -201,23 +225,30 @@ int benchCommand(const BenchRequest& request) {
   std::vector<BenchRun> runs;
   for (const Method& method : methods) {
     const Model& model = *scenes.at(method.name).model;
-    for (double value : method.isIda() ? tolerances : steps) {
+    for (double value : method.takesTolerance() ? tolerances : steps) {
       MethodParameters parameters;
       parameters.tEnd = tEnd;
       parameters.newton = settings.newton;
-      parameters.dt = method.isIda() ? tEnd / 100 : value;
+      parameters.dt = method.isIda() ? idaOutputStep(model, tEnd) : method.adaptive ? settings.dt : value;
       parameters.relativeTolerance = value;
       parameters.absoluteTolerance = value;
-      const bool keepSeries = value == (method.isIda() ? seriesTolerance : seriesStep);
+      const bool keepSeries = value == (method.takesTolerance() ? seriesTolerance : seriesStep);
       BenchRun run = measure(model, method, parameters, request.repeats, keepSeries);
-      (method.isIda() ? run.rtol : run.dt) = value;
+      (method.takesTolerance() ? run.rtol : run.dt) = value;
       run.error = run.summary.failed ? INFINITY : relativeError(run.final, referenceState);
+      run.positionError =
+          run.summary.failed ? INFINITY : (run.final.positions - referenceState.positions).lpNorm<Eigen::Infinity>();
+      run.energyError =
+          std::abs(run.final.loadEndEnergy - referenceState.loadEndEnergy) / std::abs(referenceState.loadEndEnergy);
       run.status = run.summary.failed                                                                ? "failed"
                    : !(run.summary.maxEnergyBalanceError < kBlowUpEnergyError) || !(run.error < 1.0) ? "blew-up"
                                                                                                      : "ok";
-      fmt::print("{:<16} {:>10} {:>10.4g} s CPU  error {:.3e}  energy drift {:.3e}  {}\n", method.name,
-                 fmt::format(method.isIda() ? "rtol {:g}" : "dt {:g}", value), run.cpuSeconds, run.error,
-                 run.summary.maxEnergyBalanceError, run.status);
+      fmt::print(
+          "{:<20} {:>10} {:>10.4g} s CPU {:>7} steps  error {:.3e}  position error {:.3e}  energy at load end "
+          "{:.3e}  energy drift {:.3e}  {}\n",
+          method.name, fmt::format(method.takesTolerance() ? "rtol {:g}" : "dt {:g}", value), run.cpuSeconds,
+          run.summary.steps, run.error, run.positionError, run.energyError, run.summary.maxEnergyBalanceError,
+          run.status);
       runs.push_back(std::move(run));
     }
   }
@@ -229,16 +260,18 @@ int benchCommand(const BenchRequest& request) {
   for (const Method& method : methods) {
     WorkPrecisionCurve curve{method.name, {}};
     for (const BenchRun& r : runs)
-      if (r.integrator == method.name && r.status == "ok") curve.cpuAndError.emplace_back(r.cpuSeconds, r.error);
+      if (r.integrator == method.name && r.status == "ok")
+        curve.points.push_back({r.cpuSeconds, r.error, r.energyError});
     workPrecision.push_back(std::move(curve));
     for (const BenchRun& r : runs)
       if (r.integrator == method.name && !r.series.empty())
-        series.push_back(
-            {fmt::format(method.isIda() ? "{} rtol {:g}" : "{} dt {:g}", method.name, method.isIda() ? r.rtol : r.dt),
-             r.series});
+        series.push_back({fmt::format(method.takesTolerance() ? "{} rtol {:g}" : "{} dt {:g}", method.name,
+                                      method.takesTolerance() ? r.rtol : r.dt),
+                          r.series});
   }
   renderPlots(out, own.name, tEnd, workPrecision, series);
-  fmt::print("wrote {}/work_precision.csv, work_precision.png, energy_error.png, entropy.png\n", out.string());
+  fmt::print("wrote {}/work_precision.csv, work_precision.png, {}energy_error.png, entropy.png\n", out.string(),
+             std::isnan(referenceState.loadEndEnergy) ? "" : "work_precision_energy.png, ");
   return 0;
 }
 

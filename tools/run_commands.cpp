@@ -73,7 +73,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.dt = request.dt.value_or(scene.settings.dt);
   parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
   parameters.newton = scene.settings.newton;
-  parameters.adaptive = request.adaptive || scene.settings.adaptive;
+  parameters.adaptive = request.adaptive || scene.settings.adaptive || method->adaptive;
   const double sceneAtol = scene.settings.absoluteTolerance;
   parameters.relativeTolerance = request.relativeTolerance.value_or(scene.settings.relativeTolerance);
   parameters.absoluteTolerance = request.absoluteTolerance.value_or(

@@ -4,14 +4,27 @@
 
 namespace mpx {
 
-std::optional<Method> methodByName(const std::string& name) {
+namespace {
+
+std::optional<Method> fixedStepMethod(const std::string& name) {
   if (name == "eem") return Method{name, Scheme::Eem, std::nullopt};
   if (name == "eem-entropy") return Method{name, Scheme::Eem, ThermalVariable::Entropy};
   if (name == "eem-temperature") return Method{name, Scheme::Eem, ThermalVariable::Temperature};
   if (name == "midpoint") return Method{name, Scheme::Midpoint, std::nullopt};
   if (name == "trapezoidal") return Method{name, Scheme::Trapezoidal, std::nullopt};
-  if (name == "ida") return Method{name, std::nullopt, std::nullopt};
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Method> methodByName(const std::string& name) {
+  if (name == "ida") return Method{name, std::nullopt, std::nullopt};
+  const std::string suffix = "-adaptive";
+  const bool adaptive =
+      name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  std::optional<Method> method = fixedStepMethod(adaptive ? name.substr(0, name.size() - suffix.size()) : name);
+  if (method) method->name = name, method->adaptive = adaptive;
+  return method;
 }
 
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene) {
@@ -28,7 +41,7 @@ RunSummary runMethod(const Model& model, const Method& method, const MethodParam
   if (method.isIda())
     return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.dt, p.tEnd}, sink, progress);
   const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton};
-  if (p.adaptive)
+  if (p.adaptive || method.adaptive)
     return simulateAdaptive(model, options, {p.relativeTolerance, p.absoluteTolerance, p.outputInterval}, sink,
                             progress);
   return simulate(model, options, sink, progress);

@@ -15,11 +15,16 @@ struct Method {
   std::string name;
   std::optional<Scheme> scheme;                    // the one-step scheme; none for SUNDIALS IDA
   std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
+  bool adaptive = false;                           // a one-step scheme with adaptive steps
   bool isIda() const { return !scheme; }
+  // Set by a tolerance rather than a step: IDA and the adaptive one-step schemes.
+  bool takesTolerance() const { return isIda() || adaptive; }
 };
 
-// The names methodByName accepts, for messages.
-inline constexpr const char* kMethodNames = "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, ida";
+// The names methodByName accepts, for messages; each one-step name also takes the suffix
+// "-adaptive" (eem-adaptive, midpoint-adaptive, ...).
+inline constexpr const char* kMethodNames =
+    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal (each also as NAME-adaptive), ida";
 std::optional<Method> methodByName(const std::string& name);
 
 struct MethodParameters {

@@ -6,6 +6,7 @@
 #include <fmt/os.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace mpx {
@@ -41,12 +42,16 @@ void renderPlots(const std::filesystem::path& dir, const std::string& sceneName,
   std::filesystem::create_directories(data);
   std::vector<std::filesystem::path> wpFiles, seriesFiles;
   std::vector<std::string> wpLabels, seriesLabels;
+  bool energyErrors = false;
   for (const WorkPrecisionCurve& curve : workPrecision) {
-    if (curve.cpuAndError.empty()) continue;
+    if (curve.points.empty()) continue;
     wpFiles.push_back(data / ("work_precision_" + curve.label + ".dat"));
     wpLabels.push_back(curve.label);
     auto out = fmt::output_file(wpFiles.back().string());
-    for (const auto& [cpu, error] : curve.cpuAndError) out.print("{:.6e} {:.6e}\n", cpu, std::max(error, kLogFloor));
+    for (const WorkPrecisionPoint& p : curve.points) {
+      out.print("{:.6e} {:.6e} {:.6e}\n", p.cpu, std::max(p.error, kLogFloor), std::max(p.energyError, kLogFloor));
+      energyErrors = energyErrors || !std::isnan(p.energyError);
+    }
   }
   for (std::size_t i = 0; i < series.size(); ++i) {
     seriesFiles.push_back(data / fmt::format("series_{}.dat", i));
@@ -65,6 +70,12 @@ void renderPlots(const std::filesystem::path& dir, const std::string& sceneName,
     out.print(
         "set xlabel 'CPU time [s]'\nset ylabel 'relative error at t = t_{{end}} (positions, temperatures) [-]'\n");
     out.print("{}", plotCommand(wpFiles, wpLabels, "1:2", "linespoints lw 2 pt 7"));
+    if (energyErrors) {
+      out.print("{}", header(dir / "work_precision_energy.png",
+                             fmt::format("Work-precision, energy at the end of loading, {}", sceneName)));
+      out.print("set ylabel '|E - E_{{ref}}| / |E_{{ref}}| at the end of loading [-]'\n");
+      out.print("{}", plotCommand(wpFiles, wpLabels, "1:3", "linespoints lw 2 pt 7"));
+    }
     out.print("{}", header(dir / "energy_error.png", fmt::format("Energy balance error, {}", sceneName)));
     out.print("set logscale y\nset format y '10^{{%L}}'\nset format x '%g'\n");
     out.print("set xlabel 'time [s]'\nset ylabel '|E + D - W - Q - E_0| / largest energy so far [-]'\n");

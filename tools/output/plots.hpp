@@ -1,6 +1,7 @@
 #pragma once
 // PNG plots of a work-precision study, rendered by gnuplot (a Debian package, installed by
-// tools/install-deps.sh): error against CPU time, energy error and entropy against time.
+// tools/install-deps.sh): error against CPU time (final state, and the energy at the end of
+// loading where the scene has loads), energy error and entropy against time.
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -8,9 +9,13 @@
 
 namespace mpx {
 
+struct WorkPrecisionPoint {
+  double cpu, error, energyError;  // energyError NaN: not measured
+};
+
 struct WorkPrecisionCurve {
   std::string label;
-  std::vector<std::pair<double, double>> cpuAndError;
+  std::vector<WorkPrecisionPoint> points;
 };
 
 struct SeriesPoint {
@@ -23,7 +28,7 @@ struct TimeSeries {
 };
 
 // Writes DIR/plot_data/*, DIR/plots.gp and renders DIR/work_precision.png, energy_error.png,
-// entropy.png. Throws std::runtime_error when gnuplot fails.
+// entropy.png, and work_precision_energy.png when energy errors were measured. Throws std::runtime_error when gnuplot fails.
 void renderPlots(const std::filesystem::path& dir, const std::string& sceneName, double tEnd,
                  const std::vector<WorkPrecisionCurve>& workPrecision, const std::vector<TimeSeries>& series);
 
