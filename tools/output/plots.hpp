@@ -28,8 +28,8 @@ struct TimeSeries {
 };
 
 // Writes DIR/plot_data/*, DIR/plots.gp and renders DIR/work_precision.png, energy_error.png,
-// entropy.png, and work_precision_energy.png when energy errors were measured. Throws std::runtime_error when gnuplot
-// fails.
+// entropy.png, and work_precision_energy.png when energy errors were measured. Throws
+// std::runtime_error when gnuplot fails.
 void renderPlots(const std::filesystem::path& dir, const std::string& sceneName, double tEnd,
                  const std::vector<WorkPrecisionCurve>& workPrecision, const std::vector<TimeSeries>& series);
 
