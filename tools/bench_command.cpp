@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -127,11 +128,9 @@ FinalState reference(const Model& model, const std::string& sceneText, double tE
   std::ifstream in(file);
   std::string line;
   if (std::getline(in, line) && line == "# " + key) {
+    // strtod, not >>, so that the "nan" of a scene without loads reads back
     std::vector<double> values;
-    for (double v; in >> v;) {
-      values.push_back(v);
-      if (in.peek() == ',') in.ignore();
-    }
+    for (std::string value; std::getline(in, value, ',');) values.push_back(std::strtod(value.c_str(), nullptr));
     const Eigen::Index positions = model.layout().size(Block::Position);
     if (values.size() == positions + model.thermalNodeNames().size() + 1) {
       cached.positions = Eigen::Map<Eigen::VectorXd>(values.data(), positions);

@@ -146,8 +146,8 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
 }
 
 std::string CondensedSolver::describe() const {
-  const std::string size =
-      std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) + " unknowns factorised";
+  const std::string size = std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) +
+                           " unknowns factorised by " + lu_->name();
   if (velocities_ > 0)
     return size + " (velocities" + (internal_.active() ? " and internal variables" : "") + " eliminated)";
   return wholeSystemReason_.empty() ? size : size + "; solved whole because " + wholeSystemReason_;

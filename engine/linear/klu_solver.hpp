@@ -20,6 +20,7 @@ class KluSolver final : public SparseLu {
   // Reuses the last pivots unless `repivot`.
   bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) override;
   void solve(Eigen::VectorXd& rhs) override;
+  const char* name() const override { return "KLU"; }
 
  private:
   klu_common common_;

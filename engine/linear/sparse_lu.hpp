@@ -15,13 +15,15 @@ class SparseLu {
   virtual bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) = 0;
   // Overwrite rhs with the solution of A x = rhs for the last factorised A.
   virtual void solve(Eigen::VectorXd& rhs) = 0;
+  // The factorisation's name for run summaries ("KLU", ...).
+  virtual const char* name() const = 0;
 };
 
 // KLU (pivot reuse, no allocation) for small systems such as multibody and thermal networks;
 // UMFPACK with a fill-reducing ordering for the large systems of 3D solids, where KLU is
-// 20-60 times slower (docs/performance.md).
+// 20-60 times slower (docs/performance.md). A dense LU measured no faster than KLU on the
+// smallest systems (docs/performance.md, "Small systems").
 std::unique_ptr<SparseLu> makeSparseLu(int size);
-
 // Systems of at least this many unknowns go to UMFPACK.
 inline constexpr int kLargeSystem = 3000;
 

@@ -1,7 +1,5 @@
 #include "engine/linear/umfpack_solver.hpp"
 
-#include "engine/linear/klu_solver.hpp"
-
 namespace mpx {
 
 UmfpackSolver::UmfpackSolver(int size)
@@ -31,11 +29,6 @@ void UmfpackSolver::solve(Eigen::VectorXd& rhs) {
   umfpack_di_wsolve(UMFPACK_A, matrix_->outerIndexPtr(), matrix_->innerIndexPtr(), matrix_->valuePtr(),
                     solution_.data(), rhs.data(), numeric_, control_, info_, integerWork_.data(), realWork_.data());
   rhs.swap(solution_);
-}
-
-std::unique_ptr<SparseLu> makeSparseLu(int size) {
-  if (size >= kLargeSystem) return std::make_unique<UmfpackSolver>(size);
-  return std::make_unique<KluSolver>();
 }
 
 }  // namespace mpx

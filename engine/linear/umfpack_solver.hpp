@@ -20,6 +20,7 @@ class UmfpackSolver final : public SparseLu {
 
   bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) override;
   void solve(Eigen::VectorXd& rhs) override;
+  const char* name() const override { return "UMFPACK"; }
 
  private:
   double control_[UMFPACK_CONTROL];

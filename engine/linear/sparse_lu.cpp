@@ -1,0 +1,13 @@
+#include "engine/linear/sparse_lu.hpp"
+
+#include "engine/linear/klu_solver.hpp"
+#include "engine/linear/umfpack_solver.hpp"
+
+namespace mpx {
+
+std::unique_ptr<SparseLu> makeSparseLu(int size) {
+  if (size >= kLargeSystem) return std::make_unique<UmfpackSolver>(size);
+  return std::make_unique<KluSolver>();
+}
+
+}  // namespace mpx
