@@ -50,8 +50,18 @@ Assembler::Assembler(const Model& model) {
   for (int e = 0; e < outer[n]; ++e)
     if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
   for (const PrescribedMotion& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
-  localResidual_.assign(kMaxLocalDofs, 0.0);
-  localTangent_.assign(kMaxLocalDofs * kMaxLocalDofs, 0.0);
+  const auto& components = model.components();
+  firstCoupling_ = std::partition_point(components.begin(), components.end(),
+                                        [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); }) -
+                   components.begin();
+  std::size_t largest = 0;
+  for (const auto& component : components) largest = std::max(largest, component->dofs().size());
+  const std::size_t slots = std::min(kBatch, components.size());
+  localResidual_.assign(slots * largest, 0.0);
+  localTangent_.assign(slots * largest * largest, 0.0);
+  localFlows_.resize(slots);
+  for (std::size_t b = 0; b < slots; ++b)
+    locals_.push_back({0, localResidual_.data() + b * largest, localTangent_.data() + b * largest * largest});
 }
 
 void Assembler::clear() {

@@ -2,11 +2,16 @@
 // Global residual and sparse tangent with a pattern fixed at construction. Each component's
 // local system is scattered through a precomputed map into the compressed matrix values, so
 // assembly allocates nothing and never rebuilds the pattern.
+//
+// Components are evaluated in batches, in parallel with OpenMP (OMP_NUM_THREADS threads) when
+// a batch is large enough to pay for it; the batch is then scattered in component order by one
+// thread, so the sums, and the results, are the same bit for bit for any number of threads.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
 
 #include <Eigen/Sparse>
 
+#include <algorithm>
 #include <vector>
 
 namespace mpx {
@@ -39,15 +44,36 @@ class Assembler {
   // result times `weight`.
   template <class Evaluate>
   void add(const Model& model, Workspace& ws, double weight, const Evaluate& evaluate) {
+    // couplings read the node temperatures their owners publish: all owners come first
+    addRange(model, 0, firstCoupling_, ws, weight, evaluate);
+    addRange(model, firstCoupling_, model.components().size(), ws, weight, evaluate);
+  }
+  template <class Evaluate>
+  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, double weight,
+                const Evaluate& evaluate) {
     const auto& components = model.components();
-    for (std::size_t c = 0; c < components.size(); ++c) {
-      LocalSystem local{static_cast<int>(components[c]->dofs().size()), localResidual_.data(), localTangent_.data()};
-      std::fill_n(local.r, local.n, 0.0);
-      std::fill_n(local.k, local.n * local.n, 0.0);
-      Flows componentFlows;
-      evaluate(*components[c], ws, local, componentFlows);
-      scatter(c, components[c]->dofs(), local, weight);
-      flows_ += componentFlows * weight;
+    for (std::size_t first = begin; first < end; first += kBatch) {
+      const int count = static_cast<int>(std::min<std::size_t>(kBatch, end - first));
+      auto evaluateSlot = [&](int b) {
+        LocalSystem& local = locals_[b];
+        local.n = static_cast<int>(components[first + b]->dofs().size());
+        std::fill_n(local.r, local.n, 0.0);
+        std::fill_n(local.k, local.n * local.n, 0.0);
+        localFlows_[b] = Flows{};
+        evaluate(*components[first + b], ws, local, localFlows_[b]);
+      };
+      // a small batch stays outside OpenMP altogether (even a region that runs on one thread
+      // allocates its team)
+      if (count >= kSmallestParallelBatch) {
+#pragma omp parallel for schedule(static)
+        for (int b = 0; b < count; ++b) evaluateSlot(b);
+      } else {
+        for (int b = 0; b < count; ++b) evaluateSlot(b);
+      }
+      for (int b = 0; b < count; ++b) {
+        scatter(first + b, components[first + b]->dofs(), locals_[b], weight);
+        flows_ += localFlows_[b] * weight;
+      }
     }
   }
 
@@ -75,6 +101,14 @@ class Assembler {
   std::vector<std::vector<std::pair<int, int>>> scatterMap_;
   std::vector<std::vector<int>> prescribedRowEntries_;  // per prescribed motion: its row in tangent_ values
   std::vector<int> prescribedDiagonal_;
+  // Components per batch, and the smallest batch evaluated in parallel (below it, starting the
+  // threads costs more than they save: docs/performance.md, "Parallel assembly").
+  static constexpr std::size_t kBatch = 256;
+  static constexpr int kSmallestParallelBatch = 32;
+  std::size_t firstCoupling_ = 0;
+  // one local system per batch slot, over buffers sized for the largest component
+  std::vector<LocalSystem> locals_;
+  std::vector<Flows> localFlows_;
   std::vector<double> localResidual_;
   std::vector<double> localTangent_;
 };
