@@ -21,6 +21,7 @@ struct RunRequest {
   std::optional<double> relativeTolerance, absoluteTolerance;
   // IDA only
   int maxOrder = 5;
+  bool sundialsKlu = false;
   std::optional<double> outputStep;
 };
 

@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
   addToleranceOptions(run, request);
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
+  run->add_flag("--sundials-klu", request.sundialsKlu,
+                "ida: factorise with SUNDIALS' KLU instead of Metriplex's sparse LU (KLU, UMFPACK for large systems)");
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   run->add_option("--output-interval", request.frameInterval,
                   "interval of bodies.csv and joints.csv rows and of solid frames (.vtu) (default: every history row)");

@@ -80,6 +80,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
       request.relativeTolerance || sceneAtol == 0.0 ? parameters.relativeTolerance : sceneAtol);
   parameters.outputInterval = request.frameInterval.value_or(0.0);
   parameters.maxOrder = request.maxOrder;
+  parameters.sundialsKlu = request.sundialsKlu;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
                                                   : std::filesystem::path(request.out);
@@ -117,17 +118,17 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
   fmt::print("  steps                    {}{}\n", s.steps, s.ida ? " (output times)" : "");
   fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations,
              perStep(s.newtonIterations, s.steps));
-  if (s.ida)
+  if (s.ida) {
     fmt::print(
         "  IDA                      {} steps, {} residual evaluations, {} Jacobian evaluations, "
         "{} nonlinear iterations, {} error-test failures, {} convergence failures\n",
         s.ida->steps, s.ida->residualEvaluations, s.ida->jacobianEvaluations, s.ida->nonlinearIterations,
         s.ida->errorTestFailures, s.ida->convergenceFailures);
-  else {
+  } else {
     if (run.parameters.adaptive) fmt::print("  rejected steps           {}\n", s.rejectedSteps);
     fmt::print("  cut-backs                {}\n", s.cutbacks);
-    fmt::print("  linear system            {}\n", s.linearSystem);
   }
+  fmt::print("  linear system            {}\n", s.linearSystem);
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
   fmt::print(
       "  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",

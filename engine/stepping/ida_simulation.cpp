@@ -1,6 +1,7 @@
 #include "engine/stepping/ida_simulation.hpp"
 
 #include "engine/linear/assembler.hpp"
+#include "engine/stepping/ida_linear_solver.hpp"
 
 #include <Eigen/SparseLU>
 
@@ -20,7 +21,7 @@ namespace mpx {
 
 namespace {
 
-// Models up to this many unknowns use a dense Jacobian; larger ones sparse KLU.
+// Models up to this many unknowns use a dense Jacobian; larger ones a sparse one.
 constexpr int kLargestDenseSystem = 64;
 // The energies crossing the boundary, integrated as IDA quadratures (outside the Newton system
 // and the error test): dissipated, external work, boundary heat.
@@ -47,6 +48,8 @@ class IdaProblem {
   Flows crossed() const;
   const std::string& error() const { return error_; }
   IdaStatistics statistics() const;
+  // What factorises the Newton matrix, for the run summary.
+  const std::string& linearSystem() const { return linearSystem_; }
   double lastStep() const;
 
  private:
@@ -69,6 +72,7 @@ class IdaProblem {
   SUNLinearSolver linearSolver_ = nullptr;
   void* ida_ = nullptr;
   std::string error_;
+  std::string linearSystem_;
 };
 
 IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
@@ -112,7 +116,17 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
 
   const auto nonZeros = static_cast<sunindextype>(assembler_.tangent().nonZeros());
   jacobian_ = dense_ ? SUNDenseMatrix(n, n, context_) : SUNSparseMatrix(n, n, nonZeros, CSC_MAT, context_);
-  linearSolver_ = dense_ ? SUNLinSol_Dense(y_, jacobian_, context_) : SUNLinSol_KLU(y_, jacobian_, context_);
+  if (dense_) {
+    linearSolver_ = SUNLinSol_Dense(y_, jacobian_, context_);
+  } else if (options.sundialsKlu) {
+    linearSolver_ = SUNLinSol_KLU(y_, jacobian_, context_);
+  } else {
+    linearSolver_ = makeIdaLinearSolver(assembler_.tangent(), context_);
+  }
+  linearSystem_ = std::to_string(n) + " unknowns factorised by " +
+                  (dense_                ? "dense LU (SUNDIALS)"
+                   : options.sundialsKlu ? "KLU (SUNDIALS)"
+                                         : idaLinearSolverName(linearSolver_));
   check(IDASetLinearSolver(ida_, linearSolver_, jacobian_), "IDASetLinearSolver");
   check(IDASetJacFn(ida_, jacobian), "IDASetJacFn");
 }
@@ -292,6 +306,7 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
   }
   reporter.finish();
   summary.ida = ida.statistics();
+  summary.linearSystem = ida.linearSystem();
   summary.newtonIterations = summary.ida->nonlinearIterations;
   summary.cutbacks = static_cast<int>(summary.ida->errorTestFailures);
   return summary;

@@ -15,6 +15,10 @@ struct IdaOptions {
   // given), so that a small component is judged relative to its scale rather than to zero.
   double absoluteTolerance = 1e-6;
   int maxOrder = 5;
+  // The Newton matrix of a model above kLargestDenseSystem unknowns goes to Metriplex's sparse
+  // LU (KLU, UMFPACK from kLargeSystem unknowns: engine/linear/sparse_lu.hpp), or with this
+  // set to SUNDIALS' own KLU.
+  bool sundialsKlu = false;
   double outputStep = 0.0;  // history rows at multiples of this
   double tEnd = 0.0;
 };

@@ -39,7 +39,8 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& p, const StepSink& sink,
                      const ProgressSink& progress) {
   if (method.isIda())
-    return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.dt, p.tEnd}, sink, progress);
+    return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.sundialsKlu, p.dt, p.tEnd}, sink,
+                       progress);
   const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton};
   if (p.adaptive || method.adaptive)
     return simulateAdaptive(model, options, {p.relativeTolerance, p.absoluteTolerance, p.outputInterval}, sink,

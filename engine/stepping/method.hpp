@@ -36,6 +36,7 @@ struct MethodParameters {
   double absoluteTolerance = 1e-6;  // IDA and adaptive steps, times each dof's scale
   double outputInterval = 0.0;      // adaptive steps land on its multiples
   int maxOrder = 5;                 // IDA
+  bool sundialsKlu = false;         // IDA: SUNDIALS' KLU rather than Metriplex's sparse LU
 };
 
 // Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a
