@@ -260,6 +260,29 @@ const std::vector<BadScene> kBadScenes = {
      "",
      6,
      {"<clamp>", "no surface or node set 'top'", "x0"}},
+    // integers beyond their range, absurd meshes and names that would leave the output
+    // directory: refused at the element's line
+    {"CutbacksBeyondTheirRange",
+     sceneWith("  <solver max_cutbacks=\"1e10\"/>\n  <mass name=\"m\" mass=\"1\"/>"),
+     "",
+     5,
+     {"<solver>", "'max_cutbacks'", "from 0 to 50", "1e10"}},
+    {"MeshTooLarge",
+     sceneWith("  <solid name=\"b\" mesh=\"lblock\" level=\"100\" young=\"10\" poisson=\"0.3\" density=\"1\"/>"),
+     "",
+     5,
+     {"<solid name=\"b\">", "3.6e+07 cells"}},
+    {"SceneNameLeavesTheOutputDirectory",
+     "<?xml version=\"1.0\"?>\n<metriplex name=\"../../escape\">\n  <simulation dt=\"0.1\" t_end=\"1\"/>\n"
+     "  <mass name=\"m\" mass=\"1\"/>\n</metriplex>\n",
+     "",
+     2,
+     {"scene name '../../escape'", "output files"}},
+    {"SolidNameIsAnAbsolutePath",
+     sceneWith("  <solid name=\"/tmp/x\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>"),
+     "",
+     5,
+     {"solid name '/tmp/x'", "output files"}},
     {"TractionWithoutLoad",
      sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
                "  <traction name=\"t\" solid=\"b\" surface=\"x1\"/>"),
@@ -317,7 +340,21 @@ const std::vector<BadOptions> kBadOptions = {
     {"BenchNegativeTolerance", "bench", "--rtols 1e-3,-1e-6", {"--rtols", "-1e-06"}},
     {"BenchZeroStep", "bench", "--dts 0.1,0", {"--dts", "positive"}},
     {"BenchZeroRepeats", "bench", "--repeats 0", {"--repeats"}},
+    {"TooManySteps", "run", "--dt 1e-12", {"--dt", "steps; at most 1e9"}},
+    {"CompareWithoutIntegrators", "compare", "--integrators ''", {"--integrators", "no integrator"}},
+    {"BenchWithoutIntegrators", "bench", "--integrators ''", {"--integrators", "no integrator"}},
 };
+
+// A misspelt subcommand is named; an output directory that cannot be made names --out
+TEST_F(CliTest, UnknownSubcommandAndUnusableOutputDirectoryAreNamed) {
+  const Invocation unknown = metriplex("rnu " + quoted(writeScene(kSwingScene)));
+  EXPECT_EQ(unknown.exitCode, kExitInvalidInput);
+  EXPECT_NE(unknown.err.find("unknown subcommand 'rnu'"), std::string::npos) << unknown.err;
+  const Invocation badOut = metriplex("run " + quoted(writeScene(kSwingScene)) + " --out /proc/no/such/dir");
+  EXPECT_EQ(badOut.exitCode, kExitInvalidInput);
+  EXPECT_NE(badOut.err.find("option --out: cannot create the directory /proc/no/such/dir"), std::string::npos)
+      << badOut.err;
+}
 
 // IDA's rate form cannot impose a displacement step by step: refused before anything is written,
 // naming the scene and the element (run and bench, whose reference is an IDA run).

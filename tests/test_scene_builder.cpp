@@ -150,5 +150,40 @@ TEST(SceneBuilder, XmlElementsThatTakeNoChildrenRejectThem) {
   }
 }
 
+// names that become output files cannot leave the output directory: "../x", "/abs", ".hidden"
+TEST(SceneBuilder, NamesThatBecomeFilesStayInsideTheOutputDirectory) {
+  for (const char* bad : {"../../x", "/tmp/abs", ".hidden", "a/b", ""}) {
+    const std::string scene = std::string(R"(<metriplex name=")") + bad + R"(">
+<simulation dt="0.1" t_end="1"/><mass name="m" mass="1"/></metriplex>)";
+    try {
+      compileScene(readXmlScene(scene, "names.xml"));
+      FAIL() << "scene name '" << bad << "' was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("names.xml:1: scene name '"), std::string::npos) << e.what();
+    }
+    if (!*bad) continue;  // an empty solid name is refused as a name before it is a file name
+    const std::string solid = std::string(R"(<metriplex><simulation dt="0.1" t_end="1"/>
+<solid name=")") + bad + R"(" mesh="box" size="1 1 1" cells="1 1 1" young="1" poisson="0.3" density="1"/></metriplex>)";
+    try {
+      compileScene(readXmlScene(solid, "solid.xml"));
+      FAIL() << "solid name '" << bad << "' was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("solid.xml:2: <solid name="), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("solid name '"), std::string::npos) << e.what();
+    }
+  }
+  // a long name is quoted only in part
+  SceneSpec spec;
+  spec.name = std::string(5000, 'x') + "/";
+  spec.settings.dt = spec.settings.tEnd = 1.0;
+  spec.add("mass", {{"name", "m"}, {"mass", 1.0}});
+  try {
+    compileScene(spec);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 300u) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mpx::test

@@ -187,6 +187,7 @@ void writeCsv(const std::filesystem::path& file, const std::vector<BenchRun>& ru
 int benchCommand(const BenchRequest& request) {
   // validate everything before anything is written
   if (request.repeats < 1) throw InputError("option --repeats must be at least 1");
+  if (request.integrators.empty()) throw InputError("option --integrators: no integrator given");
   for (double v : request.steps)
     if (!(v > 0.0 && std::isfinite(v)))
       throw InputError(fmt::format("option --dts: steps must be positive, got {}", v));
@@ -209,12 +210,16 @@ int benchCommand(const BenchRequest& request) {
   std::vector<double> steps = request.steps;
   if (steps.empty())
     for (double factor : {2.0, 1.0, 0.5, 0.25, 0.125, 0.0625}) steps.push_back(factor * settings.dt);
+  for (double dt : steps) checkStepCount(tEnd, dt, "option --dts");
   std::vector<double> tolerances = request.tolerances;
   if (tolerances.empty()) tolerances = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
   const std::filesystem::path out =
       request.out.empty() ? std::filesystem::path("out") / (own.name + "-bench") : std::filesystem::path(request.out);
 
-  std::filesystem::create_directories(out);
+  std::error_code error;
+  std::filesystem::create_directories(out, error);
+  if (error)
+    throw InputError(fmt::format("option --out: cannot create the directory {}: {}", out.string(), error.message()));
   const FinalState referenceState = reference(*own.model, sceneText, tEnd, out);
 
   // representative runs for the time series: the scene's step, rtol 1e-6 (or the middle ones)

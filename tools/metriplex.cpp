@@ -91,6 +91,13 @@ int main(int argc, char** argv) {
   benchCommandLine->add_option("--repeats", bench.repeats, "repeats per run (median CPU time)")->capture_default_str();
   benchCommandLine->add_option("--out", request.out, "output directory (default: out/<scene name>-bench)");
 
+  // CLI11 reports a misspelt subcommand only as "A subcommand is required": name it
+  const std::string first = argc > 1 ? argv[1] : "";
+  const auto named = app.get_subcommands([&](const CLI::App* command) { return command->get_name() == first; });
+  if (!first.empty() && first[0] != '-' && named.empty()) {
+    fmt::print(stderr, "metriplex: unknown subcommand '{}' (choose run, compare or bench; see --help)\n", first);
+    return kExitInvalidInput;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

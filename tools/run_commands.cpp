@@ -82,6 +82,8 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   parameters.maxOrder = request.maxOrder;
   parameters.sundialsKlu = request.sundialsKlu;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
+  checkStepCount(parameters.tEnd, parameters.dt,
+                 method->isIda() ? "options --t-end and --dt-out" : "options --t-end and --dt");
   std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
                                                   : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
@@ -89,7 +91,11 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
 }
 
 RunResult execute(const PreparedRun& run) {
-  std::filesystem::create_directories(run.out);
+  std::error_code error;
+  std::filesystem::create_directories(run.out, error);
+  if (error)
+    throw InputError(
+        fmt::format("option --out: cannot create the directory {}: {}", run.out.string(), error.message()));
   HistoryCsv history(run.out, *run.scene.model);
   FramesCsv frames(run.out, run.scene, run.frameInterval);
   SolidFrames solids(run.out, run.scene, run.frameInterval);
@@ -152,6 +158,7 @@ int runCommand(const RunRequest& request) {
 
 int compareCommand(const RunRequest& base, const std::vector<std::string>& integrators) {
   // validate every run before the first one writes anything
+  if (integrators.empty()) throw InputError("option --integrators: no integrator given");
   std::vector<PreparedRun> runs;
   for (const std::string& name : integrators) {
     RunRequest request = base;

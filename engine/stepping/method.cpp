@@ -2,6 +2,8 @@
 
 #include "engine/core/input_error.hpp"
 
+#include <cstdio>
+
 namespace mpx {
 
 namespace {
@@ -34,6 +36,14 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
       throw InputError(scene +
                        ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
                        "<prescribed_velocity>, or use a one-step integrator");
+}
+
+void checkStepCount(double tEnd, double dt, const std::string& where) {
+  if (!(tEnd / dt <= kMostSteps)) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.3g", tEnd / dt);
+    throw InputError(where + ": t_end / dt = " + count + " steps; at most 1e9 are taken");
+  }
 }
 
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& p, const StepSink& sink,

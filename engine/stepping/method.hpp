@@ -45,6 +45,11 @@ struct MethodParameters {
 // `scene` names the scene file in the message.
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene);
 
+// Fixed-step runs take at most this many steps (a step count must fit the step counters).
+inline constexpr double kMostSteps = 1e9;
+// Throw InputError, prefixed by `where`, if t_end / dt asks for more than kMostSteps steps.
+void checkStepCount(double tEnd, double dt, const std::string& where);
+
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& parameters, const StepSink& sink,
                      const ProgressSink& progress = nullptr);
 

@@ -6,11 +6,22 @@
 
 namespace mpx {
 
+namespace {
+
+// A value as quoted in a message: whole up to 64 characters, else its start and its length.
+std::string echoed(const std::string& value) {
+  constexpr std::size_t kLongest = 64;
+  if (value.size() <= kLongest) return value;
+  return value.substr(0, kLongest) + "... (" + std::to_string(value.size()) + " characters)";
+}
+
+}  // namespace
+
 ElementReader::ElementReader(const ElementSpec& element) : element_(element) {}
 
 void ElementReader::fail(const std::string& message) const {
   std::string what = "<" + element_.tag;
-  if (const std::string* name = element_.find("name")) what += " name=\"" + *name + "\"";
+  if (const std::string* name = element_.find("name")) what += " name=\"" + echoed(*name) + "\"";
   throw InputError(element_.where.describe() + ": " + what + ">: " + message);
 }
 
@@ -41,8 +52,9 @@ double ElementReader::parseNumber(const char* attribute, const std::string& toke
   char* end = nullptr;
   const double value = std::strtod(token.c_str(), &end);
   if (token.empty() || *end != '\0')
-    fail(std::string("attribute '") + attribute + "': '" + token + "' is not a number");
-  if (!std::isfinite(value)) fail(std::string("attribute '") + attribute + "' must be finite, got '" + token + "'");
+    fail(std::string("attribute '") + attribute + "': '" + echoed(token) + "' is not a number");
+  if (!std::isfinite(value))
+    fail(std::string("attribute '") + attribute + "' must be finite, got '" + echoed(token) + "'");
   return value;
 }
 
@@ -57,7 +69,8 @@ double ElementReader::number(const char* attribute, double fallback) {
 
 double ElementReader::positive(const char* attribute) {
   const double value = number(attribute);
-  if (!(value > 0.0)) fail(std::string("attribute '") + attribute + "' must be positive, got " + text(attribute));
+  if (!(value > 0.0))
+    fail(std::string("attribute '") + attribute + "' must be positive, got " + echoed(text(attribute)));
   return value;
 }
 
@@ -67,14 +80,16 @@ double ElementReader::positive(const char* attribute, double fallback) {
 
 double ElementReader::nonNegative(const char* attribute, double fallback) {
   const double value = number(attribute, fallback);
-  if (value < 0.0) fail(std::string("attribute '") + attribute + "' must not be negative, got " + text(attribute));
+  if (value < 0.0)
+    fail(std::string("attribute '") + attribute + "' must not be negative, got " + echoed(text(attribute)));
   return value;
 }
 
-int ElementReader::count(const char* attribute, int fallback) {
+int ElementReader::count(const char* attribute, int fallback, int largest) {
   const double value = number(attribute, fallback);
-  if (value < 0 || value != std::floor(value))
-    fail(std::string("attribute '") + attribute + "' must be a non-negative integer");
+  if (value < 0 || value > largest || value != std::floor(value))
+    fail(std::string("attribute '") + attribute + "' must be an integer from 0 to " + std::to_string(largest) +
+         ", got " + echoed(text(attribute)));
   return static_cast<int>(value);
 }
 

@@ -25,7 +25,8 @@ class ElementReader {
   double positive(const char* attribute);
   double positive(const char* attribute, double fallback);
   double nonNegative(const char* attribute, double fallback);
-  int count(const char* attribute, int fallback);
+  // An integer from 0 to `largest`.
+  int count(const char* attribute, int fallback, int largest);
   Vec3 vector(const char* attribute, const Vec3& fallback);
   // "true" or "false".
   bool flag(const char* attribute, bool fallback);

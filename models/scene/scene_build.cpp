@@ -1,6 +1,7 @@
 #include "models/scene/scene_build.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <stdexcept>
 
 namespace mpx {
@@ -187,6 +188,17 @@ std::string elementTags() {
        {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
     for (const ElementKind& kind : *family) tags += (tags.empty() ? "" : ", ") + std::string(kind.tag);
   return tags;
+}
+
+std::string fileNameProblem(const std::string& name) {
+  constexpr std::size_t kLongest = 64;
+  const bool allowed = std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '_' || c == '-' || c == '.' || c == '+';
+  });
+  if (name.empty() || name.size() > kLongest || !allowed || name.front() == '.')
+    return "'" + name.substr(0, kLongest) + (name.size() > kLongest ? "...'" : "'") +
+           " names output files, so it must be 1 to 64 of A-Z a-z 0-9 _ - . + and not start with '.'";
+  return "";
 }
 
 namespace {

@@ -27,6 +27,7 @@ void checkSettings(const SceneSpec& scene) {
   require(s.dt > 0.0 && std::isfinite(s.dt) && s.tEnd > 0.0 && std::isfinite(s.tEnd),
           "the simulation needs finite dt > 0 and t_end > 0");
   require(methodByName(s.integrator).has_value(), "unknown integrator '" + s.integrator + "'");
+  checkStepCount(s.tEnd, s.dt, SourceLocation{scene.label, scene.line, 0}.describe() + ": <simulation>");
   require(s.relativeTolerance > 0.0 && std::isfinite(s.relativeTolerance) && s.absoluteTolerance >= 0.0 &&
               std::isfinite(s.absoluteTolerance),
           "rtol must be positive and atol non-negative");
@@ -36,6 +37,8 @@ void checkSettings(const SceneSpec& scene) {
   require(scene.gravity.allFinite(), "gravity must be finite");
   require(scene.constraints.stiffness > 0.0 && std::isfinite(scene.constraints.stiffness),
           "the constraint stiffness must be positive");
+  if (const std::string problem = fileNameProblem(scene.name); !problem.empty())
+    throw InputError(SourceLocation{scene.label, scene.line, 0}.describe() + ": scene name " + problem);
 }
 
 // The state layout: each element's declared dofs, in element order within each block.

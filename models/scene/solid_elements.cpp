@@ -7,6 +7,8 @@
 #include "models/scene/gmsh_reader.hpp"
 #include "models/scene/scene_build.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -26,13 +28,24 @@ struct MeshSource {
   std::array<int, 3> cells = {1, 1, 1};
 };
 
+// Generated meshes have at most this many cells (the L-block at level 30 has 972 000).
+constexpr double kLargestGeneratedMesh = 1e6;
+// Cells of the L-block at level 1; level L has L^3 as many.
+constexpr int kLBlockCells = 36;
+
 // Read (and so mark as read) the mesh attributes of a <solid>.
 MeshSource readMeshSource(ElementReader& in) {
   MeshSource source;
   source.kind = in.text("mesh");
+  auto checkSize = [&](double cells) {
+    if (cells > kLargestGeneratedMesh)
+      in.fail(
+          fmt::format("the mesh would have {:.3g} cells; at most {:.0f} are generated", cells, kLargestGeneratedMesh));
+  };
   if (source.kind == "lblock") {
-    source.level = in.count("level", 1);
+    source.level = in.count("level", 1, 1000);
     if (source.level < 1) in.fail("level must be at least 1");
+    checkSize(kLBlockCells * std::pow(source.level, 3));
   } else if (source.kind == "box") {
     source.origin = in.vector("origin", Vec3::Zero());
     source.size = in.vector("size", Vec3::Ones());
@@ -40,8 +53,10 @@ MeshSource readMeshSource(ElementReader& in) {
     if (cells.size() != 3) in.fail("cells needs three counts (x y z)");
     for (int k = 0; k < 3; ++k) {
       if (!(cells[k] >= 1) || cells[k] != std::floor(cells[k])) in.fail("cells must be positive integers");
+      checkSize(cells[k]);
       source.cells[k] = static_cast<int>(cells[k]);
     }
+    checkSize(static_cast<double>(source.cells[0]) * source.cells[1] * source.cells[2]);
     if (!(source.size.minCoeff() > 0.0)) in.fail("size must be positive in every direction");
   }
   source.offset = in.vector("offset", Vec3::Zero());
@@ -112,6 +127,7 @@ DofDemand declareSolid(ElementReader& in, SceneBuild& build) {
 
 void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   const std::string name = build.declareName(in);
+  if (const std::string problem = fileNameProblem(name); !problem.empty()) in.fail("solid name " + problem);
   readMeshSource(in);
   const std::shared_ptr<const Mesh> mesh = build.meshOfSolid.at(&in.element());
   std::shared_ptr<const HyperelasticMaterial> material;

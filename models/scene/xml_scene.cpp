@@ -52,8 +52,9 @@ void readSimulation(ElementReader& in, SceneSettings& settings) {
 void readSolver(ElementReader& in, NewtonSettings& n) {
   n.incrementTolerance = in.positive("increment_tolerance", n.incrementTolerance);
   n.residualTolerance = in.positive("residual_tolerance", n.residualTolerance);
-  n.maxIterations = in.count("max_iterations", n.maxIterations);
-  n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks);
+  // more halvings than 50 take the step below 1e-15 of itself
+  n.maxIterations = in.count("max_iterations", n.maxIterations, 10000);
+  n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks, 50);
   n.predictor = in.flag("predictor", n.predictor);
   n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
   if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
