@@ -283,6 +283,19 @@ const std::vector<BadScene> kBadScenes = {
      "",
      5,
      {"solid name '/tmp/x'", "output files"}},
+    // degenerate joint geometry is an input error, not a singular tangent at the first step
+    {"JointWithOneBodyAtBothEnds",
+     sceneWith("  <body name=\"l\" mass=\"1\" inertia=\"1 1 1\" position=\"1 0 0\"/>\n"
+               "  <joint name=\"j\" type=\"revolute\" a=\"l\" b=\"l\"/>"),
+     "",
+     6,
+     {"<joint name=\"j\">", "two different ends"}},
+    {"UniversalJointWithParallelAxes",
+     sceneWith("  <body name=\"l\" mass=\"1\" inertia=\"1 1 1\" position=\"1 0 0\"/>\n"
+               "  <joint name=\"j\" type=\"universal\" a=\"pivot\" b=\"l\" axis=\"0 0 1\" axis_b=\"0 0 2\"/>"),
+     "",
+     6,
+     {"<joint name=\"j\">", "perpendicular", "cosine between them is 1"}},
     {"TractionWithoutLoad",
      sceneWith("  <solid name=\"b\" mesh=\"box\" cells=\"1 1 1\" young=\"10\" poisson=\"0.3\" density=\"1\"/>\n"
                "  <traction name=\"t\" solid=\"b\" surface=\"x1\"/>"),
@@ -344,6 +357,22 @@ const std::vector<BadOptions> kBadOptions = {
     {"CompareWithoutIntegrators", "compare", "--integrators ''", {"--integrators", "no integrator"}},
     {"BenchWithoutIntegrators", "bench", "--integrators ''", {"--integrators", "no integrator"}},
 };
+
+// A face pushed through the opposite one would turn the cell inside out, where C = F^T F and
+// the energy still look regular: the run stops there as a solver failure (it used to finish
+// with exit 0 in the mirrored configuration)
+TEST_F(CliTest, InvertingACellIsASolverFailure) {
+  const Invocation r = metriplex(
+      "run " +
+      quoted(writeScene(sceneWith(
+          "  <solid name=\"bar\" mesh=\"box\" cells=\"1 1 1\" material=\"svk\" young=\"1e3\" poisson=\"0.3\" "
+          "density=\"10\"/>\n  <clamp solid=\"bar\" surface=\"x0\"/>\n  <prescribed_displacement solid=\"bar\" "
+          "surface=\"x1\" displacement=\"-2 0 0\" profile=\"ramp\" end=\"1\"/>"))) +
+      " --out " + quoted(outDir()));
+  EXPECT_EQ(r.exitCode, kExitSolverFailure) << r.err;
+  EXPECT_NE(r.err.find("solver failure at step 5 (t = 0.5)"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(outDir() / "history.csv"));
+}
 
 // A misspelt subcommand is named; an output directory that cannot be made names --out
 TEST_F(CliTest, UnknownSubcommandAndUnusableOutputDirectoryAreNamed) {

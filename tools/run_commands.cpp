@@ -55,6 +55,8 @@ ProgressSink progressBar(const std::string& label) {
   };
 }
 
+// The default output directory is out/<scene>-<outSuffix>, or out/<scene>-<integrator> when
+// outSuffix is empty.
 PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   checkPositive(request.dt, "--dt");
   checkPositive(request.tEnd, "--t-end");
@@ -84,8 +86,10 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   checkStepCount(parameters.tEnd, parameters.dt,
                  method->isIda() ? "options --t-end and --dt-out" : "options --t-end and --dt");
-  std::filesystem::path out = request.out.empty() ? std::filesystem::path("out") / (scene.name + "-" + outSuffix)
-                                                  : std::filesystem::path(request.out);
+  std::filesystem::path out =
+      request.out.empty()
+          ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
+          : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
   return {*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
 }
@@ -146,7 +150,7 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
 }  // namespace
 
 int runCommand(const RunRequest& request) {
-  const PreparedRun run = prepare(request, request.integrator.empty() ? "run" : request.integrator);
+  const PreparedRun run = prepare(request, "");
   const RunResult result = execute(run);
   printSummary(result, request, run);
   if (!result.summary.failed) return 0;

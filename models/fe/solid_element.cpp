@@ -2,6 +2,8 @@
 
 #include "models/fe/discrete_stress.hpp"
 
+#include <limits>
+
 namespace mpx {
 
 namespace {
@@ -70,6 +72,11 @@ void SolidElement::measure(const double* z, Measures& out) const {
   }
 }
 
+// A cell turned inside out (det F <= 0) is no admissible state, although C = F^T F, and with it
+// every energy, looks regular there: a non-finite residual makes Newton backtrack or the step
+// fail, instead of the run going on in a mirrored configuration.
+void SolidElement::rejectInverted(LocalSystem& out) { out.r[0] = std::numeric_limits<double>::quiet_NaN(); }
+
 template <class MaterialIncrement>
 void SolidElement::assemblePoint(int q, const PointEvaluation& e, const MaterialIncrement& materialIncrement,
                                  LocalSystem& out) const {
@@ -127,6 +134,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const ShapeGradients& G = spec_.points[q].gradients;
     const Mat3 F0 = x0 * G, F1 = x1 * G;
+    if (!(F1.determinant() > 0.0)) return rejectInverted(out);
     const Mat3 C0 = F0.transpose() * F0, C1 = F1.transpose() * F1;
     const DiscreteStress discrete(*spec_.material, C0, C1);
     PointEvaluation e{0.5 * (F0 + F1), 0.5, F1, discrete.stress()};
@@ -149,6 +157,7 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
   const NodePositions x = positions(args.z);
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
+    if (!(F.determinant() > 0.0)) return rejectInverted(out);
     PointEvaluation e{F, 1.0, F, spec_.material->stress(C)};
     e.strainFactor = 0.5;
     e.gammaFactor = 1.0;

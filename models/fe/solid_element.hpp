@@ -55,6 +55,8 @@ class SolidElement final : public Component {
   struct PointEvaluation;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
+  // Mark the evaluation of a state with an inverted cell as inadmissible.
+  static void rejectInverted(LocalSystem& out);
   // Add the point's residual rows and tangent columns; materialIncrement(dC) is the change
   // of the hyperelastic stress for a change dC of the end point's C.
   template <class MaterialIncrement>

@@ -4,6 +4,8 @@
 #include "models/multibody/joint_force.hpp"
 #include "models/scene/scene_build.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Eigenvalues>
 
 namespace mpx {
@@ -91,6 +93,11 @@ void buildJoint(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   geometry.axisB.normalize();
   if (*type == JointType::Distance && !((geometry.anchor - geometry.anchorB).norm() > 0.0))
     in.fail("a distance joint needs anchor and anchor_b apart");
+  // degenerate geometry would otherwise surface as a singular tangent at the first step
+  if (*in.element().find("a") == *in.element().find("b")) in.fail("a joint needs two different ends, a and b");
+  if (*type == JointType::Universal && !(std::abs(geometry.axis.dot(geometry.axisB)) <= 1e-6))
+    in.fail(fmt::format("a universal joint needs axis_b perpendicular to axis (the cosine between them is {:.3g})",
+                        geometry.axis.dot(geometry.axisB)));
   const double coordinate = in.number("coordinate", 0.0);
   const ConstraintSettings settings = build.constraintSettings(in);
   const JointBuilder builder(a, b);
