@@ -123,5 +123,22 @@ TEST(AdaptiveLandings, StepsLandOnBreakpointsAndOutputTimes) {
   EXPECT_LT(maxBalanceDrift(h), 1e-12 * largestEnergy(h));
 }
 
+// 3 x 0.3 falls ulps short of 0.9: an output time that close to a ramp's end (and to t_end)
+// is the same landing, so the step lands on the breakpoint itself, with no sliver of a step
+// after it
+TEST(AdaptiveLandings, OutputTimesUlpsFromABreakpointAreOneLanding) {
+  SceneSpec spec;
+  spec.settings.dt = spec.settings.tEnd = 0.9;
+  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
+  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
+  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
+  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0, 0)}, {"profile", "ramp"}, {"end", 0.9}});
+  const CompiledScene scene = compileScene(spec);
+  ASSERT_LT(3 * 0.3, 0.9);
+  const History h = runAdaptive(*scene.model, Scheme::Eem, 1e-6, 0.9, 0.05, 0.3);
+  EXPECT_EQ(h.time.back(), 0.9);
+  for (std::size_t n = 1; n < h.time.size(); ++n) EXPECT_GT(h.dt[n], 1e-6) << "step " << n;
+}
+
 }  // namespace
 }  // namespace mpx::test

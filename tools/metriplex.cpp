@@ -36,8 +36,8 @@ void addToleranceOptions(CLI::App* command, RunRequest& request) {
   command->add_option("--rtol", request.relativeTolerance,
                       "ida and adaptive steps: relative tolerance (default: the scene's simulation rtol, 1e-6)");
   command->add_option("--atol", request.absoluteTolerance,
-                      "ida and adaptive steps: absolute tolerance, times each dof's scale (default: the scene's atol, "
-                      "else --rtol)");
+                      "ida and adaptive steps: absolute tolerance, times each dof's scale (default: --rtol when given, "
+                      "else the scene's atol, else its rtol)");
 }
 
 }  // namespace

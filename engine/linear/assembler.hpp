@@ -19,6 +19,9 @@ namespace mpx {
 class Assembler {
  public:
   explicit Assembler(const Model& model);
+  // The local systems point into the assembler's own buffers.
+  Assembler(const Assembler&) = delete;
+  Assembler& operator=(const Assembler&) = delete;
 
   // Zero residual, tangent values and the flows of the evaluation.
   void clear();

@@ -111,11 +111,14 @@ class Landings {
 
   // The first landing time after t, and whether the loads have a kink there.
   std::pair<double, bool> after(double t) const {
+    // landings within `slack` of each other are one (k * interval may fall ulps short of a
+    // breakpoint or of t_end); the breakpoint or t_end is the one kept
     const double slack = 1e-12 * tEnd_;
     double next = tEnd_;
     if (interval_ > 0.0) next = std::min(next, (std::floor((t + slack) / interval_) + 1.0) * interval_);
+    if (next > tEnd_ - slack) next = tEnd_;
     const auto kink = std::upper_bound(breakpoints_.begin(), breakpoints_.end(), t + slack);
-    if (kink != breakpoints_.end() && *kink <= next) return {*kink, true};
+    if (kink != breakpoints_.end() && *kink <= next + slack) return {*kink, true};
     return {next, false};
   }
 
@@ -205,8 +208,13 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
       localError.accept(t + 0.5 * dt, reporter.state());
     }
     accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome);
-    // a step shortened to land does not hold back the next one
-    proposed = std::max(dt * stepFactor(error), lands ? proposed : 0.0);
+    // the next step from the last one taken and its own error (a half step of a doubling has
+    // half the pair's); a step shortened to land may be followed by one up to the size
+    // proposed before, as far as its error allows
+    const double taken = doubling ? 0.5 * dt : dt, takenError = doubling ? 0.5 * error : error;
+    const double allowed = takenError > 0.0 ? kSafety * std::cbrt(1.0 / takenError) : INFINITY;
+    proposed = lands && taken < proposed ? std::min(proposed, taken * std::max(kLargestShrink, allowed))
+                                         : taken * stepFactor(takenError);
     if (kink) {
       localError.restart(tNew, reporter.state());
     } else {

@@ -40,7 +40,8 @@ class IdaProblem {
   IdaProblem& operator=(const IdaProblem&) = delete;
 
   // Consistent initial rates (and multipliers) for the initial state; false on failure.
-  bool initialise();
+  // IDACalcIC takes its step scale from the first output time.
+  bool initialise(double firstOutput);
   // Integrate to tout; false on failure (see error()).
   bool advanceTo(double tout);
   const double* state() const { return N_VGetArrayPointer(y_); }
@@ -201,11 +202,17 @@ Flows IdaProblem::crossed() const {
   return {q[0], q[1], q[2]};
 }
 
-bool IdaProblem::initialise() {
-  // The rate form is linear in the rates and the multipliers, so one linear solve from
-  // (rates, multipliers) = 0 is exact: differential rows F = 0, and for each algebraic row (no
-  // rate, no multiplier in it) dF/dz . zdot = 0. IDACalcIC handles index 1 only, and its
-  // line search fails at tight tolerances (rtol 1e-12 on the two thermo-springs).
+bool IdaProblem::initialise(double firstOutput) {
+  // IDACalcIC handles index 1 only, and its line search fails at tight tolerances (rtol 1e-12
+  // on the two thermo-springs); then, and for every model with multipliers, one linear solve
+  // from (rates, multipliers) = 0: differential rows F = 0, and for each algebraic row (no
+  // rate, no multiplier in it) dF/dz . zdot = 0. That is exact where the rate form is linear
+  // in the rates and multipliers, which smoothed joint friction (F tanh(rate / v_s)) is not:
+  // a joint with friction that moves at t = 0 starts from linearised rates.
+  if (!model_.layout().has(Block::Multiplier) && IDACalcIC(ida_, IDA_YA_YDP_INIT, firstOutput) >= 0 &&
+      IDAGetConsistentIC(ida_, y_, yp_) >= 0)
+    return true;
+  error_.clear();
   const Layout& layout = model_.layout();
   const int n = modelSize_;
   N_VConst(0.0, yp_);
@@ -288,7 +295,8 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
     summary.failedTime = t;
     summary.failure = what + ": " + ida.error();
   };
-  if (!ida.initialise()) fail(0, 0.0, "consistent initial conditions failed");
+  if (!ida.initialise(std::min(options.outputStep, 0.01 * options.tEnd)))
+    fail(0, 0.0, "consistent initial conditions failed");
   long previousIterations = 0, previousErrorTestFailures = 0;
   for (int k = 1; k <= outputs && !summary.failed; ++k) {
     const double tout = k == outputs ? options.tEnd : k * options.outputStep;

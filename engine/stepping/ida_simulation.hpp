@@ -1,9 +1,9 @@
 #pragma once
 // The SUNDIALS IDA baseline (run through IDAS, the same BDF solver with quadratures): the model's rate form F(t, z,
 // zdot) = 0 (Component::rateLocal) integrated by variable-order, variable-step BDF with the analytic Jacobian dF/dz +
-// cj dF/dzdot, dense for small models and sparse (KLU) for large ones. Energies that cross the boundary (D' =
-// dissipated power, W' = external power, Q' = boundary heat rate) are IDA quadratures: integrated along, outside the
-// Newton system and the error test.
+// cj dF/dzdot, dense for small models and sparse (engine/stepping/ida_linear_solver.hpp) for large ones. Energies that
+// cross the boundary (D' = dissipated power, W' = external power, Q' = boundary heat rate) are IDA quadratures:
+// integrated along, outside the Newton system and the error test.
 #include "engine/stepping/simulation.hpp"
 
 namespace mpx {
