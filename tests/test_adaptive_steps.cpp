@@ -121,6 +121,13 @@ TEST(AdaptiveLandings, StepsLandOnBreakpointsAndOutputTimes) {
     EXPECT_NE(std::find(h.time.begin(), h.time.end(), landing), h.time.end()) << "no step ends at " << landing;
   EXPECT_GT(h.externalWork.back(), 0.0);
   EXPECT_LT(maxBalanceDrift(h), 1e-12 * largestEnergy(h));
+  // step doubling (two equal steps) only where the history restarts, at t = 0 and the two
+  // kinks, plus at most one split in two per landing: not on every step towards a kink
+  int equalPairs = 0;
+  for (std::size_t n = 1; n + 1 < h.dt.size(); ++n) equalPairs += h.dt[n] == h.dt[n + 1];
+  std::printf("%zu steps, %d pairs of equal steps\n", h.dt.size() - 1, equalPairs);
+  EXPECT_GT(h.dt.size(), 40u);
+  EXPECT_LE(equalPairs, 3 + 9);
 }
 
 // 3 x 0.3 falls ulps short of 0.9: an output time that close to a ramp's end (and to t_end)

@@ -215,7 +215,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     const double allowed = takenError > 0.0 ? kSafety * std::cbrt(1.0 / takenError) : INFINITY;
     proposed = lands && taken < proposed ? std::min(proposed, taken * std::max(kLargestShrink, allowed))
                                          : taken * stepFactor(takenError);
-    if (kink) {
+    if (kink && lands) {
       localError.restart(tNew, reporter.state());
     } else {
       localError.accept(tNew, reporter.state());
