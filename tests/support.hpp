@@ -1,9 +1,11 @@
 #pragma once
 // Shared helpers for the tests: fixture scenes from tests/data/, runs collected in memory, and
 // conservation checks computed from a run's history.
+#include "engine/stepping/method.hpp"
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -65,6 +67,29 @@ History collect(Runner runWith) {
 
 inline History run(const Model& model, Scheme scheme, double dt, double tEnd, NewtonSettings newton = {}) {
   return collect([&](const StepSink& sink) { return simulate(model, {scheme, dt, tEnd, newton}, sink); });
+}
+
+// SUNDIALS IDA at rtol = atol (per dof scale), history rows every outputStep (default t_end/20).
+inline History runIda(const Model& model, double rtol, double tEnd, bool sundialsKlu = false, double outputStep = 0.0) {
+  MethodParameters parameters;
+  parameters.sundialsKlu = sundialsKlu;
+  parameters.dt = outputStep > 0.0 ? outputStep : tEnd / 20;
+  parameters.tEnd = tEnd;
+  parameters.relativeTolerance = rtol;
+  parameters.absoluteTolerance = rtol;
+  return collect([&](const StepSink& sink) { return runMethod(model, *methodByName("ida"), parameters, sink); });
+}
+
+// Least-squares slope of log(y) against log(x): an observed order of convergence.
+inline double logLogSlope(const std::vector<double>& x, const std::vector<double>& y) {
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += std::log(x[i]) / x.size(), my += std::log(y[i]) / x.size();
+  double sxy = 0, sxx = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxy += (std::log(x[i]) - mx) * (std::log(y[i]) - my);
+    sxx += (std::log(x[i]) - mx) * (std::log(x[i]) - mx);
+  }
+  return sxy / sxx;
 }
 
 // Conservation checks computed from a history (not taken from the engine's own summary).

@@ -14,15 +14,9 @@ namespace {
 
 constexpr double kEndTime = 2.0;
 
-History runIda(const Model& model, double rtol, double tEnd = kEndTime, bool sundialsKlu = false) {
-  MethodParameters parameters;
-  parameters.sundialsKlu = sundialsKlu;
-  parameters.dt = tEnd / 20;
-  parameters.tEnd = tEnd;
-  parameters.relativeTolerance = rtol;
-  parameters.absoluteTolerance = rtol;
-  const History h =
-      collect([&](const StepSink& sink) { return runMethod(model, *methodByName("ida"), parameters, sink); });
+// runIda to kEndTime unless told otherwise, failing the test if IDA fails
+History checkedIdaRun(const Model& model, double rtol, double tEnd = kEndTime, bool sundialsKlu = false) {
+  History h = runIda(model, rtol, tEnd, sundialsKlu);
   EXPECT_FALSE(h.summary.failed) << h.summary.failure;
   return h;
 }
@@ -50,7 +44,7 @@ TEST_P(IdaAgainstEem, TightIdaAgreesWithFineEem) {
   const Agreement c = GetParam();
   const CompiledScene scene = loadScene(scenePath(c.scene));
   const History eem = run(*scene.model, Scheme::Eem, c.eemStep, kEndTime);
-  const History ida = runIda(*scene.model, 1e-10);
+  const History ida = checkedIdaRun(*scene.model, 1e-10);
   ASSERT_DOUBLE_EQ(ida.time.back(), kEndTime);
   const double gap = distance(*scene.model, eem.states.back(), ida.states.back());
   std::printf("%s: |EEM(dt %g) - IDA(rtol 1e-10)| at t = 2: %.3e\n", c.scene, c.eemStep, gap);
@@ -62,10 +56,10 @@ TEST_P(IdaAgainstEem, TightIdaAgreesWithFineEem) {
 TEST_P(IdaAgainstEem, ErrorDecreasesWithTolerance) {
   const char* file = GetParam().scene;
   const CompiledScene scene = loadScene(scenePath(file));
-  const Eigen::VectorXd reference = runIda(*scene.model, 1e-11).states.back();
+  const Eigen::VectorXd reference = checkedIdaRun(*scene.model, 1e-11).states.back();
   std::vector<double> errors;
   for (double rtol : {1e-4, 1e-6, 1e-8}) {
-    errors.push_back(distance(*scene.model, runIda(*scene.model, rtol).states.back(), reference));
+    errors.push_back(distance(*scene.model, checkedIdaRun(*scene.model, rtol).states.back(), reference));
     std::printf("%s: IDA rtol %g error %.3e\n", file, rtol, errors.back());
     if (errors.size() > 1) {
       EXPECT_LT(errors.back(), errors[errors.size() - 2]) << "rtol " << rtol;
@@ -88,10 +82,10 @@ INSTANTIATE_TEST_SUITE_P(Scenes, IdaAgainstEem,
 // they agree to the integration error, and both are as close to a tight reference
 TEST(IdaLinearSolver, OwnSparseLuAgreesWithSundialsKlu) {
   const CompiledScene scene = loadScene(scenePath("damped_double_pendulum.xml"));
-  const History own = runIda(*scene.model, 1e-8), sundials = runIda(*scene.model, 1e-8, kEndTime, true);
+  const History own = checkedIdaRun(*scene.model, 1e-8), sundials = checkedIdaRun(*scene.model, 1e-8, kEndTime, true);
   EXPECT_EQ(own.summary.linearSystem, "93 unknowns factorised by KLU");
   EXPECT_EQ(sundials.summary.linearSystem, "93 unknowns factorised by KLU (SUNDIALS)");
-  const Eigen::VectorXd reference = runIda(*scene.model, 1e-11).states.back();
+  const Eigen::VectorXd reference = checkedIdaRun(*scene.model, 1e-11).states.back();
   const double gap = distance(*scene.model, own.states.back(), sundials.states.back());
   const double ownError = distance(*scene.model, own.states.back(), reference);
   const double sundialsError = distance(*scene.model, sundials.states.back(), reference);
@@ -105,7 +99,7 @@ TEST(IdaLinearSolver, OwnSparseLuAgreesWithSundialsKlu) {
 // IDA does not keep the energy: its drift at rtol 1e-6 is visible where EEM's is round-off
 TEST(IdaEnergy, DriftsWhereEemDoesNot) {
   const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));
-  const History ida = runIda(*scene.model, 1e-6, 200.0);
+  const History ida = checkedIdaRun(*scene.model, 1e-6, 200.0);
   double drift = 0.0;
   for (double e : ida.energy) drift = std::max(drift, std::abs(e - ida.energy.front()) / std::abs(ida.energy.front()));
   std::printf("IDA rtol 1e-6 relative energy drift over t in [0, 200]: %.3e\n", drift);
@@ -117,7 +111,7 @@ TEST(IdaEnergy, DriftsWhereEemDoesNot) {
 // vertical angular momentum to the integration error.
 TEST(IdaConstraints, RunsTheSpinningHeavyTop) {
   const CompiledScene scene = loadScene(scenePath("heavy_top.xml"));
-  const History ida = runIda(*scene.model, 1e-8, 0.2);
+  const History ida = checkedIdaRun(*scene.model, 1e-8, 0.2);
   ASSERT_FALSE(ida.states.empty());
   ASSERT_DOUBLE_EQ(ida.time.back(), 0.2);
   Measures m;

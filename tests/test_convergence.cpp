@@ -27,19 +27,6 @@ Eigen::VectorXd finalState(const Model& model, Scheme scheme, double dt) {
   return h.states.back();
 }
 
-// least-squares slope of log(error) against log(dt)
-double slope(const std::vector<double>& dts, const std::vector<double>& errors) {
-  double mx = 0, my = 0;
-  for (std::size_t i = 0; i < dts.size(); ++i)
-    mx += std::log(dts[i]) / dts.size(), my += std::log(errors[i]) / dts.size();
-  double sxy = 0, sxx = 0;
-  for (std::size_t i = 0; i < dts.size(); ++i) {
-    sxy += (std::log(dts[i]) - mx) * (std::log(errors[i]) - my);
-    sxx += (std::log(dts[i]) - mx) * (std::log(dts[i]) - mx);
-  }
-  return sxy / sxx;
-}
-
 class ConvergenceOrder : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ConvergenceOrder, IsTwo) {
@@ -49,7 +36,7 @@ TEST_P(ConvergenceOrder, IsTwo) {
   std::vector<double> dts(std::begin(kSteps), std::end(kSteps)), errors;
   for (double dt : dts)
     errors.push_back((finalState(*scene.model, c.scheme, dt) - reference).lpNorm<Eigen::Infinity>());
-  const double order = slope(dts, errors);
+  const double order = logLogSlope(dts, errors);
   std::printf("%s on %s: errors", c.label, c.scene);
   for (double e : errors) std::printf(" %.3e", e);
   std::printf(", observed order %.3f\n", order);

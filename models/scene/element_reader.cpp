@@ -6,16 +6,11 @@
 
 namespace mpx {
 
-namespace {
-
-// A value as quoted in a message: whole up to 64 characters, else its start and its length.
 std::string echoed(const std::string& value) {
   constexpr std::size_t kLongest = 64;
   if (value.size() <= kLongest) return value;
   return value.substr(0, kLongest) + "... (" + std::to_string(value.size()) + " characters)";
 }
-
-}  // namespace
 
 ElementReader::ElementReader(const ElementSpec& element) : element_(element) {}
 

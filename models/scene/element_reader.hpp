@@ -12,6 +12,9 @@
 
 namespace mpx {
 
+// A value as quoted in a message: whole up to 64 characters, else its start and its length.
+std::string echoed(const std::string& value);
+
 class ElementReader {
  public:
   explicit ElementReader(const ElementSpec& element);

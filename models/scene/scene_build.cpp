@@ -196,7 +196,7 @@ std::string fileNameProblem(const std::string& name) {
     return std::isalnum(c) || c == '_' || c == '-' || c == '.' || c == '+';
   });
   if (name.empty() || name.size() > kLongest || !allowed || name.front() == '.')
-    return "'" + name.substr(0, kLongest) + (name.size() > kLongest ? "...'" : "'") +
+    return "'" + echoed(name) + "'" +
            " names output files, so it must be 1 to 64 of A-Z a-z 0-9 _ - . + and not start with '.'";
   return "";
 }

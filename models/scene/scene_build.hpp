@@ -163,8 +163,8 @@ std::string elementTags();
 
 // Names that become file or directory names under the output directory (the scene's, a
 // solid's) must be 1 to 64 of A-Z a-z 0-9 _ - . + and not start with '.', so that no name can
-// reach outside the output directory. Returns what is wrong with `name` (quoting at most 64
-// characters of it), or "".
+// reach outside the output directory. Returns what is wrong with `name` (quoted by echoed()),
+// or "".
 std::string fileNameProblem(const std::string& name);
 
 // The time function of a load: profile="constant|ramp|hat|sine_pulse|table" and its parameters.
