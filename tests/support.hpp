@@ -40,7 +40,7 @@ inline std::string schemeName(Scheme scheme) {
 
 // Everything a run reports, step by step.
 struct History {
-  std::vector<double> time, dt, energy, entropy, dissipated, externalWork, boundaryHeat;
+  std::vector<double> time, dt, energy, entropy, dissipated, externalWork, boundaryHeat, boundaryEntropy;
   std::vector<Vec3> momentum, angularMomentum;
   std::vector<Eigen::VectorXd> states;
   RunSummary summary;
@@ -58,6 +58,7 @@ History collect(Runner runWith) {
     h.dissipated.push_back(r.crossed.dissipated);
     h.externalWork.push_back(r.crossed.externalWork);
     h.boundaryHeat.push_back(r.crossed.boundaryHeat);
+    h.boundaryEntropy.push_back(r.crossed.boundaryEntropy);
     h.momentum.push_back(r.measures->momentum);
     h.angularMomentum.push_back(r.measures->angularMomentum);
     h.states.push_back(*r.state);

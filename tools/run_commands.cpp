@@ -100,7 +100,7 @@ RunResult execute(const PreparedRun& run) {
   if (error)
     throw InputError(
         fmt::format("option --out: cannot create the directory {}: {}", run.out.string(), error.message()));
-  HistoryCsv history(run.out, *run.scene.model);
+  HistoryCsv history(run.out, run.scene);
   FramesCsv frames(run.out, run.scene, run.frameInterval);
   SolidFrames solids(run.out, run.scene, run.frameInterval);
   RunResult result{
@@ -143,7 +143,8 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
   fmt::print(
       "  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
       s.maxEnergyBalanceError);
-  fmt::print("  min entropy increment    {:.3e}\n", s.minEntropyIncrement);
+  fmt::print("  min entropy production   {:.3e}  (per step: S change minus entropy brought in)\n",
+             s.minEntropyProduction);
   fmt::print("  history                  {}\n", r.history.string());
 }
 
@@ -172,7 +173,7 @@ int compareCommand(const RunRequest& base, const std::vector<std::string>& integ
   }
   const std::filesystem::path root = base.out.empty() ? runs.front().out : std::filesystem::path(base.out);
   fmt::print("{:<16} {:>8} {:>12} {:>10} {:>16} {:>16}  {}\n", "integrator", "steps", "newton/step", "wall [s]",
-             "max energy drift", "min dS per step", "status");
+             "max energy drift", "min production", "status");
   // a blow-up is a finding here, not an error
   for (PreparedRun& run : runs) {
     run.out = root / run.method.name;
@@ -181,7 +182,7 @@ int compareCommand(const RunRequest& base, const std::vector<std::string>& integ
     const std::string status =
         s.failed ? fmt::format("failed at step {} (t = {:.6g}): {}", s.failedStep, s.failedTime, s.failure) : "ok";
     fmt::print("{:<16} {:>8} {:>12.2f} {:>10.3f} {:>16.3e} {:>16.3e}  {}\n", run.method.name, s.steps,
-               perStep(s.newtonIterations, s.steps), s.wallSeconds, s.maxEnergyBalanceError, s.minEntropyIncrement,
+               perStep(s.newtonIterations, s.steps), s.wallSeconds, s.maxEnergyBalanceError, s.minEntropyProduction,
                status);
   }
   fmt::print("histories in {}/<integrator>/history.csv\n", root.string());

@@ -11,9 +11,10 @@ namespace mpx {
 
 using Vec3 = Eigen::Vector3d;
 
-// Largest number of local dofs of one component: a viscoelastic 8-node hexahedron touches 24
-// positions, their 24 velocity rows and 6 internal variables at each of 8 quadrature points.
-inline constexpr int kMaxLocalDofs = 96;
+// Largest number of local dofs of one component: a thermo-viscoelastic 8-node hexahedron
+// touches 24 positions, their 24 velocity rows, 6 internal variables at each of 8 quadrature
+// points and 8 temperatures.
+inline constexpr int kMaxLocalDofs = 104;
 
 // Temperature of a thermal node as seen by the heat links that touch it: the discrete
 // temperature theta~ in an EEM step, theta(z) in a rate evaluation. The owner publishes it
@@ -49,20 +50,25 @@ struct RateArgs {
 
 // Power crossing the system boundary or leaving the mechanical energy (W): viscous power
 // without a thermal node, power of time-dependent external loads, heat through prescribed
-// temperatures into the system.
-// The same triple, integrated over a step or a run, is the energy that crossed (J).
+// temperatures and thermal boundaries into the system; and the entropy that heat brings in
+// (W/K: heat over the temperature at which it crosses).
+// The same, integrated over a step or a run, is the energy (J) and entropy (J/K) that crossed.
 struct Flows {
   double dissipated = 0.0;
   double externalWork = 0.0;
   double boundaryHeat = 0.0;
+  double boundaryEntropy = 0.0;
 
   Flows& operator+=(const Flows& other) {
     dissipated += other.dissipated;
     externalWork += other.externalWork;
     boundaryHeat += other.boundaryHeat;
+    boundaryEntropy += other.boundaryEntropy;
     return *this;
   }
-  Flows operator*(double factor) const { return {factor * dissipated, factor * externalWork, factor * boundaryHeat}; }
+  Flows operator*(double factor) const {
+    return {factor * dissipated, factor * externalWork, factor * boundaryHeat, factor * boundaryEntropy};
+  }
 };
 
 // Local residual r (n) and tangent K (n x n, column-major), zeroed before each evaluation.

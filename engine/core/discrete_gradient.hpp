@@ -139,4 +139,20 @@ DiscreteGradient gonzalezGradient(const Fn& f, unsigned mask, const Vec3& a, con
   return out;
 }
 
+// The logarithmic mean (b - a)/ln(b/a) of two positive temperatures and its derivative with
+// respect to b: the discrete temperature D_theta e / D_theta eta of a heat capacity with e linear
+// and eta logarithmic in theta, for which c (b - a) = mean * c ln(b/a) holds exactly. Near
+// b = a the series in u = b/a - 1 (error below 1e-13 relative), never 0/0.
+struct LogarithmicMean {
+  double value = 0.0;
+  double derivative = 0.0;  // d value / d b
+};
+
+inline LogarithmicMean logarithmicMean(double a, double b) {
+  const double u = b / a - 1.0;
+  if (std::abs(u) < 1e-3) return {a * (1.0 + u * (0.5 + u * (-1.0 / 12 + u / 24))), 0.5 + u * (-1.0 / 6 + u / 8)};
+  const double logRatio = std::log(b / a), value = (b - a) / logRatio;
+  return {value, (1.0 - value / b) / logRatio};
+}
+
 }  // namespace mpx

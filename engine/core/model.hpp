@@ -17,16 +17,19 @@ namespace mpx {
 // Which thermal variable the Thermal block holds.
 enum class ThermalVariable { Temperature, Entropy };
 
-// A velocity dof whose motion is prescribed (a clamped or driven node): its momentum row is
-// replaced by the condition, and the reaction force does boundary work. Either the velocity
-// v(t) = amplitude * profile(t), or the displacement u(t) = amplitude * profile(t), imposed in
-// a step through the mean velocity (v + v')/2 = (u(t + dt) - u(t))/dt, which the kinematic row
-// turns into x' - x = u(t + dt) - u(t) exactly.
+// A dof whose value is prescribed: a clamped or driven node's velocity, whose momentum row is
+// replaced by the condition while the reaction force does boundary work, or a temperature
+// (Dirichlet), whose heat-balance row is replaced while the reaction is the heat brought in.
+// Velocity: v(t) = amplitude * profile(t). Displacement: u(t) = amplitude * profile(t), imposed
+// in a step through the mean velocity (v + v')/2 = (u(t + dt) - u(t))/dt, which the kinematic
+// row turns into x' - x = u(t + dt) - u(t) exactly. Temperature: theta(t) = amplitude * profile(t).
+enum class PrescribedKind { Velocity, Displacement, Temperature };
+
 struct PrescribedMotion {
   int dof;
   double amplitude;
   TimeFunction profile;
-  bool displacement = false;
+  PrescribedKind kind = PrescribedKind::Velocity;
 };
 
 class Model {

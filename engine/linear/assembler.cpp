@@ -2,6 +2,8 @@
 
 #include "engine/linear/sparse_entry.hpp"
 
+#include "engine/core/discrete_gradient.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -77,12 +79,20 @@ void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, con
   for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
 }
 
-void Assembler::replaceRow(std::size_t k, int dof, double value, double diagonal, double velocity) {
-  flows_.externalWork += residual_[dof] * velocity;
+void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double rate) {
+  const double reaction = residual_[p.dof];
+  // a prescribed temperature's reaction is the heat it supplies, which brings entropy at that
+  // temperature (`rate` holds it); a prescribed velocity's reaction does work
+  if (p.kind == PrescribedKind::Temperature) {
+    flows_.boundaryHeat += reaction;
+    flows_.boundaryEntropy += reaction / rate;
+  } else {
+    flows_.externalWork += reaction * rate;
+  }
   double* values = tangent_.valuePtr();
   for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
   values[prescribedDiagonal_[k]] = diagonal;
-  residual_[dof] = value;
+  residual_[p.dof] = value;
 }
 
 void Assembler::imposeStepMotions(const Model& model, const double* zOld, const double* zNew, double t, double dt) {
@@ -91,10 +101,13 @@ void Assembler::imposeStepMotions(const Model& model, const double* zOld, const 
     const PrescribedMotion& p = prescribed[k];
     const double change = p.amplitude * (p.profile(t + dt) - p.profile(t));
     const double meanVelocity = 0.5 * (zOld[p.dof] + zNew[p.dof]);
-    if (p.displacement)
-      replaceRow(k, p.dof, meanVelocity - change / dt, 0.5, meanVelocity);
+    // heat through a prescribed temperature enters at the discrete temperature its cells use
+    const double rate =
+        p.kind == PrescribedKind::Temperature ? logarithmicMean(zOld[p.dof], zNew[p.dof]).value : meanVelocity;
+    if (p.kind == PrescribedKind::Displacement)
+      replaceRow(k, p, meanVelocity - change / dt, 0.5, meanVelocity);
     else
-      replaceRow(k, p.dof, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, meanVelocity);
+      replaceRow(k, p, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, rate);
   }
 }
 
@@ -102,7 +115,7 @@ void Assembler::imposeRateMotions(const Model& model, const double* z, const dou
   const auto& prescribed = model.prescribedMotions();
   for (std::size_t k = 0; k < prescribed.size(); ++k) {
     const PrescribedMotion& p = prescribed[k];
-    replaceRow(k, p.dof, zdot[p.dof] - p.amplitude * p.profile.slope(t), beta, z[p.dof]);
+    replaceRow(k, p, zdot[p.dof] - p.amplitude * p.profile.slope(t), beta, z[p.dof]);
   }
 }
 

@@ -25,7 +25,7 @@ namespace {
 constexpr int kLargestDenseSystem = 64;
 // The energies crossing the boundary, integrated as IDA quadratures (outside the Newton system
 // and the error test): dissipated, external work, boundary heat.
-constexpr int kQuadratures = 3;
+constexpr int kQuadratures = 4;
 // Absolute tolerance of the multipliers (forces, in the model's units) in IDA's Newton test;
 // they are left out of the error test, and the GGL multiplier mu stays at round-off, so a
 // tolerance tied to the positions' would ask Newton to resolve noise.
@@ -194,12 +194,13 @@ int IdaProblem::flows(realtype t, N_Vector y, N_Vector yp, N_Vector rates, void*
   out[0] = flows.dissipated;
   out[1] = flows.externalWork;
   out[2] = flows.boundaryHeat;
-  return std::isfinite(out[0] + out[1] + out[2]) ? 0 : 1;
+  out[3] = flows.boundaryEntropy;
+  return std::isfinite(out[0] + out[1] + out[2] + out[3]) ? 0 : 1;
 }
 
 Flows IdaProblem::crossed() const {
   const double* q = N_VGetArrayPointer(crossed_);
-  return {q[0], q[1], q[2]};
+  return {q[0], q[1], q[2], q[3]};
 }
 
 bool IdaProblem::initialise(double firstOutput) {

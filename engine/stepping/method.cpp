@@ -32,7 +32,7 @@ std::optional<Method> methodByName(const std::string& name) {
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene) {
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
-    if (motion.displacement)
+    if (motion.kind == PrescribedKind::Displacement)
       throw InputError(scene +
                        ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
                        "<prescribed_velocity>, or use a one-step integrator");

@@ -31,14 +31,13 @@ void RunReporter::report(int step, double time, double dt, const Flows& crossed,
   record_.cutbacks = cutbacks;
   sink_(record_);
 
-  // conservation figures: the energy balance against t = 0, the smallest entropy increment
+  // conservation figures: the energy balance against t = 0, the smallest entropy production of a step
   summary_.maxEnergyBalanceError = std::max(
       summary_.maxEnergyBalanceError,
       balance_.relativeError(measures_.energy, crossed.dissipated, crossed.externalWork, crossed.boundaryHeat));
-  const double entropyIncrement = measures_.entropy - previousEntropy_;
-  summary_.minEntropyIncrement =
-      step == 1 ? entropyIncrement : std::min(summary_.minEntropyIncrement, entropyIncrement);
-  previousEntropy_ = measures_.entropy;
+  const double produced = measures_.entropy - crossed.boundaryEntropy - previousEntropy_;
+  summary_.minEntropyProduction = step == 1 ? produced : std::min(summary_.minEntropyProduction, produced);
+  previousEntropy_ = measures_.entropy - crossed.boundaryEntropy;
   summary_.steps = step;
   // at most about a hundred progress reports
   if (progress_ && time >= nextProgress_) {

@@ -74,9 +74,9 @@ struct RunSummary {
   // energy drift net of dissipated energy D, external work W and boundary heat Q (the plain
   // energy drift for an isolated system)
   double maxEnergyBalanceError = 0.0;
-  double minEntropyIncrement = 0.0;  // min_n (S_n - S_{n-1})
-  std::optional<IdaStatistics> ida;  // set for IDA runs
-  std::string linearSystem;          // what each Newton iteration factorises (one-step schemes)
+  double minEntropyProduction = 0.0;  // min_n of S_n - S_{n-1} minus the entropy brought in
+  std::optional<IdaStatistics> ida;   // set for IDA runs
+  std::string linearSystem;           // what each Newton iteration factorises (one-step schemes)
   bool failed = false;
   int failedStep = 0;
   double failedTime = 0.0;
@@ -113,7 +113,7 @@ class RunReporter {
   Measures measures_;
   StepRecord record_;
   EnergyBalance balance_{0.0};
-  double previousEntropy_ = 0.0;
+  double previousEntropy_ = 0.0;  // S minus the entropy brought in, at the last report
   std::chrono::steady_clock::time_point start_;
 };
 

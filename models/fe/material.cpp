@@ -73,12 +73,17 @@ Mat3 adjugate(const Mat3& m) {
 
 // ln J1 - ln J0 = ln(1 + (det C1 - det C0)/det C0)/2, the determinant difference expanded in
 // D = C1 - C0: det(C0 + D) - det C0 = tr(adj(C0) D) + tr(C0 adj(D)) + det D.
-double NeoHooke::energyDifference(const Mat3& C0, const Mat3& C1) const {
+double logJacobianChange(const Mat3& C0, const Mat3& C1) {
   const Mat3 D = C1 - C0;
   const double det0 = C0.determinant();
   const double detDifference = (adjugate(C0) * D).trace() + (C0 * adjugate(D)).trace() + D.determinant();
   if (!(det0 > 0.0) || !(det0 + detDifference > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  const double logJ0 = 0.5 * std::log(det0), logJChange = 0.5 * std::log1p(detDifference / det0);
+  return 0.5 * std::log1p(detDifference / det0);
+}
+
+double NeoHooke::energyDifference(const Mat3& C0, const Mat3& C1) const {
+  const Mat3 D = C1 - C0;
+  const double logJ0 = logJacobian(C0), logJChange = logJacobianChange(C0, C1);
   return 0.5 * lame_.mu * D.trace() - lame_.mu * logJChange +
          0.5 * lame_.lambda * logJChange * (2.0 * logJ0 + logJChange);
 }
@@ -100,6 +105,24 @@ Mat3 NeoHooke::stressIncrement(const Mat3& C, const Mat3& dC) const {
   const Mat3 inverse = C.inverse();
   return 0.5 * lame_.lambda * inverse.cwiseProduct(dC).sum() * inverse +
          (lame_.mu - lame_.lambda * logJ) * inverse * dC * inverse;
+}
+
+VolumeLogarithm::VolumeLogarithm(double coefficient) : coefficient_(coefficient) {}
+
+double VolumeLogarithm::energy(const Mat3& C) const { return coefficient_ * logJacobian(C); }
+
+// 2 d(c ln J)/dC = c C^-1
+Mat3 VolumeLogarithm::stress(const Mat3& C) const {
+  return C.determinant() > 0.0 ? Mat3(coefficient_ * C.inverse()) : Mat3::Constant(std::nan(""));
+}
+
+Mat3 VolumeLogarithm::stressIncrement(const Mat3& C, const Mat3& dC) const {
+  const Mat3 inverse = C.inverse();
+  return -coefficient_ * inverse * dC * inverse;
+}
+
+double VolumeLogarithm::energyDifference(const Mat3& C0, const Mat3& C1) const {
+  return coefficient_ * logJacobianChange(C0, C1);
 }
 
 double ViscousBranch::energy(const Mat3& C, const Mat3& Gamma) const {

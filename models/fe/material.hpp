@@ -58,6 +58,36 @@ class NeoHooke final : public HyperelasticMaterial {
   LameParameters lame_;
 };
 
+// W = c ln J, J = sqrt(det C): the volumetric part of a thermoelastic coupling (c = 3 beta K), as a law of C so that
+// its discrete derivative is the same Gonzalez stress as any hyperelastic energy's. NaN for det C <= 0.
+class VolumeLogarithm final : public HyperelasticMaterial {
+ public:
+  explicit VolumeLogarithm(double coefficient);
+  double energy(const Mat3& C) const override;
+  Mat3 stress(const Mat3& C) const override;
+  Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
+  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
+
+ private:
+  double coefficient_;
+};
+
+// ln J1 - ln J0 without cancellation (NaN unless both determinants are positive).
+double logJacobianChange(const Mat3& C0, const Mat3& C1);
+
+// Thermal constants of a thermoelastic solid (docs/theory.md section 9): free energy per reference volume
+//   Psi(C, theta) = W(C) - 3 beta K (theta - theta_R) ln J + kappa [theta - theta_R - theta ln(theta/theta_R)],
+// so heating expands (beta > 0), entropy eta = 3 beta K ln J + kappa ln(theta/theta_R) and internal energy
+// e = W + 3 beta K theta_R ln J + kappa (theta - theta_R); Fourier conduction Q = -k0 Grad theta.
+struct ThermalMaterial {
+  double expansion = 0.0;             // beta, linear thermal expansion coefficient (1/K)
+  double bulkModulus = 0.0;           // K = lambda + 2 mu/3 of the elastic law
+  double capacity = 1.0;              // kappa, heat capacity per reference volume (J/(m^3 K))
+  double conductivity = 0.0;          // k0 (W/(m K))
+  double referenceTemperature = 1.0;  // theta_R (K)
+  double couplingModulus() const { return 3.0 * expansion * bulkModulus; }
+};
+
 // Maxwell branch in Green strain with a viscous strain Gamma (symmetric): Psi_v = lambda_v/2 tr(A)^2 + mu_v A:A,
 // A = E - Gamma; its stress S_v = dPsi_v/dE = lambda_v tr(A) I + 2 mu_v A; evolution dGamma/dt = S_v / eta
 // (eta > 0 viscosity), so the dissipation S_v:S_v/eta >= 0. Quadratic in (C, Gamma): its midpoint derivative is an

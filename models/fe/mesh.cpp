@@ -1,6 +1,7 @@
 #include "models/fe/mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace mpx {
@@ -65,6 +66,40 @@ std::vector<int> Mesh::nodesOf(const std::string& name) const {
   std::sort(result.begin(), result.end());
   result.erase(std::unique(result.begin(), result.end()), result.end());
   return result;
+}
+
+// int N_a dA over a face at reference coordinates: a third of the area per triangle node, a
+// 2 x 2 Gauss rule on a bilinear quadrilateral.
+namespace {
+std::array<double, 4> faceNodeAreas(const Face& face, const std::vector<Vec3>& nodes) {
+  std::array<double, 4> area = {0, 0, 0, 0};
+  const auto& n = face.nodes;
+  if (face.count == 3) {
+    const double third = (nodes[n[1]] - nodes[n[0]]).cross(nodes[n[2]] - nodes[n[0]]).norm() / 6;
+    area = {third, third, third, 0.0};
+    return area;
+  }
+  const double g = 1 / std::sqrt(3.0);
+  for (double xi : {-g, g})
+    for (double eta : {-g, g}) {
+      const double shape[4] = {(1 - xi) * (1 - eta) / 4, (1 + xi) * (1 - eta) / 4, (1 + xi) * (1 + eta) / 4,
+                               (1 - xi) * (1 + eta) / 4};
+      const Vec3 dXi = ((1 - eta) * (nodes[n[1]] - nodes[n[0]]) + (1 + eta) * (nodes[n[2]] - nodes[n[3]])) / 4;
+      const Vec3 dEta = ((1 - xi) * (nodes[n[3]] - nodes[n[0]]) + (1 + xi) * (nodes[n[2]] - nodes[n[1]])) / 4;
+      const double jacobian = dXi.cross(dEta).norm();
+      for (int a = 0; a < 4; ++a) area[a] += shape[a] * jacobian;
+    }
+  return area;
+}
+}  // namespace
+
+std::map<int, double> surfaceNodeAreas(const Mesh& mesh, const std::vector<Face>& faces) {
+  std::map<int, double> nodeArea;
+  for (const Face& face : faces) {
+    const std::array<double, 4> share = faceNodeAreas(face, mesh.nodes);
+    for (int a = 0; a < face.count; ++a) nodeArea[face.nodes[a]] += share[a];
+  }
+  return nodeArea;
 }
 
 }  // namespace mpx

@@ -50,6 +50,10 @@ std::vector<Face> cellFaces(const Cell& cell);
 // Orientation-free identity of a face: its sorted nodes, -1 filling a triangle's fourth slot.
 std::array<int, 4> faceKey(const Face& face);
 
+// int N_a dA of each node of `faces` at reference coordinates, summed over the faces (a third
+// of the area per triangle node, a 2 x 2 Gauss rule on a bilinear quadrilateral).
+std::map<int, double> surfaceNodeAreas(const Mesh& mesh, const std::vector<Face>& faces);
+
 // A boundary face and the cell it belongs to.
 struct CellFace {
   Face face;

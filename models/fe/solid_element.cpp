@@ -2,6 +2,8 @@
 
 #include "models/fe/discrete_stress.hpp"
 
+#include "engine/core/discrete_gradient.hpp"
+
 #include <limits>
 
 namespace mpx {
@@ -18,6 +20,7 @@ std::vector<int> collectDofs(const SolidElementSpec& spec) {
   if (spec.branch)
     for (std::size_t k = 0; k < 6 * spec.points.size(); ++k)
       dofs.push_back(spec.firstInternalDof + static_cast<int>(k));
+  if (spec.thermal) dofs.insert(dofs.end(), spec.thermalDofs.begin(), spec.thermalDofs.end());
   return dofs;
 }
 
@@ -42,12 +45,34 @@ struct SolidElement::PointEvaluation {
   Mat3 gammaRate = Mat3::Zero();                 // (Gamma' - Gamma)/dt or dGamma/dt
   double gammaRateCoefficient = 0.0;             // its derivative: 1/dt or beta
   double tangentScale = 1.0;                     // 1 or alpha
+  // thermal cells: the point's temperature theta = sum_a N_a T_a, its derivative with respect
+  // to each node's temperature dof, the coupling stress per unit (theta_R - theta) and the rate
+  // of the coupling entropy 3 beta K ln J
+  double temperature = 0.0;
+  ShapeValues temperatureSlope = ShapeValues::Zero();
+  Mat3 couplingStress = Mat3::Zero();
+  double entropyRate = 0.0;
+};
+
+// The nodal temperatures T_a the heat rows are weighted with and their derivatives dT_a/dtheta_a.
+struct SolidElement::NodeTemperatures {
+  ShapeValues value = ShapeValues::Zero();
+  ShapeValues slope = ShapeValues::Zero();
 };
 
 SolidElement::SolidElement(SolidElementSpec spec)
     : Component(spec.name, collectDofs(spec)),
       spec_(std::move(spec)),
-      nodes_(static_cast<int>(spec_.positionDofs.size())) {}
+      nodes_(static_cast<int>(spec_.positionDofs.size())),
+      firstThermal_(6 * nodes_ + (spec_.branch ? 6 * static_cast<int>(spec_.points.size()) : 0)) {
+  nodeVolume_.setZero();
+  for (const CellPoint& p : spec_.points) nodeVolume_ += p.weight * p.values;
+  if (spec_.thermal) coupling_.emplace(spec_.thermal->couplingModulus());
+}
+
+double SolidElement::pointTemperature(int q, const NodeTemperatures& nodes) const {
+  return spec_.points[q].values.dot(nodes.value);
+}
 
 SolidElement::NodePositions SolidElement::positions(const double* z) const {
   NodePositions x = NodePositions::Zero();
@@ -68,7 +93,20 @@ void SolidElement::measure(const double* z, Measures& out) const {
     const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
     double energy = spec_.material->energy(C);
     if (spec_.branch) energy += spec_.branch->energy(C, viscousStrain(z, static_cast<int>(q)));
+    if (coupling_) {
+      const double couplingEntropy = coupling_->energy(C);
+      energy += spec_.thermal->referenceTemperature * couplingEntropy;
+      out.entropy += spec_.points[q].weight * couplingEntropy;
+    }
     out.energy += spec_.points[q].weight * energy;
+  }
+  if (!spec_.thermal) return;
+  // the heat capacity, lumped at the nodes
+  const ThermalMaterial& m = *spec_.thermal;
+  for (int a = 0; a < nodes_; ++a) {
+    const double theta = z[spec_.thermalDofs[a]];
+    out.energy += nodeVolume_[a] * m.capacity * (theta - m.referenceTemperature);
+    out.entropy += nodeVolume_[a] * m.capacity * std::log(theta / m.referenceTemperature);
   }
 }
 
@@ -96,6 +134,13 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
       r[gammaRow + k] = e.gammaRate(i, j) - fluidity * e.branchStress(i, j);
     }
 
+  // a thermal cell's nodes are heated by the branch: d(S_v:S_v/eta) = 2 S_v:dS_v/eta
+  auto addHeatingColumn = [&](int column, const Mat3& dBranch) {
+    if (!spec_.thermal) return;
+    const double dHeating = 2.0 * w * fluidity * contract(e.branchStress, dBranch);
+    for (int a = 0; a < nodes_; ++a) K(firstThermal_ + a, column) -= s * spec_.points[q].values[a] * dHeating;
+  };
+
   // columns of the end positions: dF = e_j dN_b/dX^T changes C by dF^T F + F^T dF
   for (int b = 0; b < nodes_; ++b)
     for (int j = 0; j < 3; ++j) {
@@ -108,11 +153,21 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
         dStress += dBranch;
         for (int k = 0; k < 6; ++k)
           K(gammaRow + k, 3 * b + j) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+        addHeatingColumn(3 * b + j, dBranch);
       }
       const Mat3 dPiola = w * (e.forceGradientFactor * dF * e.stress + e.forceGradient * dStress);
       for (int a = 0; a < nodes_; ++a)
         K.block<3, 1>(momentumRow + 3 * a, 3 * b + j) += s * dPiola * G.row(a).transpose();
     }
+
+  // columns of the temperatures: the coupling stress changes by -dtheta S_L
+  if (spec_.thermal) {
+    const Mat3 dPiola = -w * e.forceGradient * e.couplingStress;
+    for (int b = 0; b < nodes_; ++b)
+      for (int a = 0; a < nodes_; ++a)
+        K.block<3, 1>(momentumRow + 3 * a, firstThermal_ + b) +=
+            s * e.temperatureSlope[b] * dPiola * G.row(a).transpose();
+  }
   if (!spec_.branch) return;
 
   // columns of the viscous strain (a unit symmetric tensor per component)
@@ -126,11 +181,37 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
     for (int k = 0; k < 6; ++k)
       K(gammaRow + k, gammaRow + m) -= s * fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
     K(gammaRow + m, gammaRow + m) += e.gammaRateCoefficient;
+    addHeatingColumn(gammaRow + m, dBranch);
+  }
+}
+
+void SolidElement::assembleHeat(int q, const PointEvaluation& e, const Mat3& entropyRateGradient,
+                                const NodeTemperatures& nodes, LocalSystem& out) const {
+  auto r = out.residual();
+  auto K = out.tangent();
+  const CellPoint& p = spec_.points[q];
+  const double heating =
+      spec_.branch ? p.weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity : 0.0;
+  for (int a = 0; a < nodes_; ++a) {
+    const int row = firstThermal_ + a;
+    const double share = p.weight * p.values[a];
+    r[row] += nodes.value[a] * share * e.entropyRate - p.values[a] * heating;
+    K(row, row) += e.tangentScale * nodes.slope[a] * share * e.entropyRate;
+    for (int b = 0; b < nodes_; ++b)
+      K.block<1, 3>(row, 3 * b) += nodes.value[a] * share * p.gradients.row(b) * entropyRateGradient;
   }
 }
 
 void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
   const NodePositions x0 = positions(args.zOld), x1 = positions(args.zNew);
+  NodeTemperatures nodes;
+  if (spec_.thermal)
+    for (int a = 0; a < nodes_; ++a) {
+      const int dof = spec_.thermalDofs[a];
+      const LogarithmicMean mean = logarithmicMean(args.zOld[dof], args.zNew[dof]);
+      nodes.value[a] = mean.value;
+      nodes.slope[a] = mean.derivative;
+    }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const ShapeGradients& G = spec_.points[q].gradients;
     const Mat3 F0 = x0 * G, F1 = x1 * G;
@@ -146,15 +227,52 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
       e.branchStress = spec_.branch->stress(0.5 * (C0 + C1), 0.5 * (gamma0 + gamma1));
       e.stress += e.branchStress;
       e.gammaRate = (gamma1 - gamma0) / args.dt;
-      flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+      if (!spec_.thermal)
+        flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+    }
+    // the coupling stress acts at the point's discrete temperature, with the Gonzalez stress of
+    // 3 beta K ln J; the coupling entropy's change is exact
+    std::optional<DiscreteStress> coupling;
+    double couplingShift = 0.0;
+    Mat3 entropyRateGradient = Mat3::Zero();
+    if (spec_.thermal) {
+      coupling.emplace(*coupling_, C0, C1);
+      e.temperature = pointTemperature(q, nodes);
+      e.temperatureSlope = spec_.points[q].values.cwiseProduct(nodes.slope);
+      e.couplingStress = coupling->stress();
+      couplingShift = spec_.thermal->referenceTemperature - e.temperature;
+      e.stress += couplingShift * e.couplingStress;
+      e.entropyRate = coupling_->energyDifference(C0, C1) / args.dt;
+      entropyRateGradient = spec_.thermal->couplingModulus() / args.dt * F1.inverse();
     }
     assemblePoint(
-        q, e, [&](const Mat3& dC) { return discrete.increment(dC); }, out);
+        q, e,
+        [&](const Mat3& dC) {
+          Mat3 dStress = discrete.increment(dC);
+          if (coupling) dStress += couplingShift * coupling->increment(dC);
+          return dStress;
+        },
+        out);
+    if (spec_.thermal) assembleHeat(q, e, entropyRateGradient, nodes, out);
   }
+  // the heat capacity: m_a kappa (theta_a' - theta_a) = T_a m_a kappa ln(theta_a'/theta_a)
+  if (spec_.thermal)
+    for (int a = 0; a < nodes_; ++a) {
+      const int row = firstThermal_ + a, dof = spec_.thermalDofs[a];
+      const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
+      out.r[row] += capacity * (args.zNew[dof] - args.zOld[dof]) / args.dt;
+      out.tangent()(row, row) += capacity / args.dt;
+    }
 }
 
 void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  const NodePositions x = positions(args.z);
+  const NodePositions x = positions(args.z), xRate = positions(args.zdot);
+  NodeTemperatures nodes;
+  if (spec_.thermal)
+    for (int a = 0; a < nodes_; ++a) {
+      nodes.value[a] = args.z[spec_.thermalDofs[a]];
+      nodes.slope[a] = 1.0;
+    }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
     if (!(F.determinant() > 0.0)) return rejectInverted(out);
@@ -167,11 +285,40 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
       e.branchStress = spec_.branch->stress(C, viscousStrain(args.z, q));
       e.stress += e.branchStress;
       e.gammaRate = viscousStrain(args.zdot, q);
-      flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+      if (!spec_.thermal)
+        flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+    }
+    // coupling stress at theta_h; the coupling entropy's rate 3 beta K tr(F^-1 dF/dt)
+    double couplingShift = 0.0;
+    Mat3 entropyRateGradient = Mat3::Zero();
+    if (spec_.thermal) {
+      const double modulus = spec_.thermal->couplingModulus();
+      const Mat3 inverse = F.inverse(), rate = xRate * spec_.points[q].gradients;
+      e.temperature = pointTemperature(q, nodes);
+      e.temperatureSlope = spec_.points[q].values;
+      e.couplingStress = coupling_->stress(C);
+      couplingShift = spec_.thermal->referenceTemperature - e.temperature;
+      e.stress += couplingShift * e.couplingStress;
+      e.entropyRate = modulus * (inverse * rate).trace();
+      entropyRateGradient = modulus * (args.beta * inverse - args.alpha * inverse * rate * inverse);
     }
     assemblePoint(
-        q, e, [&](const Mat3& dC) { return spec_.material->stressIncrement(C, dC); }, out);
+        q, e,
+        [&](const Mat3& dC) {
+          Mat3 dStress = spec_.material->stressIncrement(C, dC);
+          if (coupling_) dStress += couplingShift * coupling_->stressIncrement(C, dC);
+          return dStress;
+        },
+        out);
+    if (spec_.thermal) assembleHeat(q, e, entropyRateGradient, nodes, out);
   }
+  if (spec_.thermal)
+    for (int a = 0; a < nodes_; ++a) {
+      const int row = firstThermal_ + a;
+      const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
+      out.r[row] += capacity * args.zdot[spec_.thermalDofs[a]];
+      out.tangent()(row, row) += args.beta * capacity;
+    }
 }
 
 Mat3 SolidElement::meanCauchyStress(const double* z) const {

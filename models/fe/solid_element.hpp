@@ -9,7 +9,15 @@
 // equal to the change of stored energy, and being F_m S~ they conserve angular momentum.
 // The viscous strain follows (Gamma' - Gamma)/dt = S_v/eta, dissipating S_v:S_v/eta.
 // Local dofs: node positions, their velocity (momentum) rows, 6 viscous strain components
-// (xx, yy, zz, xy, yz, xz) per quadrature point.
+// (xx, yy, zz, xy, yz, xz) per quadrature point, nodal temperatures.
+//
+// A thermoelastic cell (docs/theory.md section 9) adds the coupling stress (theta_R - theta) 3 beta K C^-1 and the
+// nodes' heat-balance rows T_a [sum_q w N_a (eta_q' - eta_q)/dt] + m_a kappa (theta_a' - theta_a)/dt - heating_a,
+// with T_a the nodal discrete temperature (the logarithmic mean of theta_a, theta_a') and theta = sum_a N_a T_a at
+// the points; the heat capacity's entropy is lumped at the nodes (m_a = int N_a dV). Since every cell weighs its
+// contribution to node a's row with the same T_a, the rows are T_a times a nodal entropy balance: summed with weight
+// 1 / T_a they give the entropy change, summed with weight 1 the energy change, both exactly. The branch's
+// dissipation heats the nodes (weights N_a) instead of leaving the system.
 #include "models/fe/material.hpp"
 #include "models/fe/shape_functions.hpp"
 
@@ -28,18 +36,24 @@ struct SolidElementSpec {
   std::vector<CellPoint> points;  // stiffness rule
   std::shared_ptr<const HyperelasticMaterial> material;
   std::optional<ViscousBranch> branch;
+  std::optional<ThermalMaterial> thermal;
+  std::vector<int> thermalDofs;  // thermal dof of each node, cell order (thermal cells only)
 };
 
 class SolidElement final : public Component {
  public:
   explicit SolidElement(SolidElementSpec spec);
 
-  // momentum rows depend on positions and every viscous strain, the viscous rows of a point on
-  // positions and that point's own strains; nothing depends on velocities
+  // momentum and thermal rows depend on positions, strains and temperatures, the viscous rows
+  // of a point on positions and that point's own strains; nothing depends on velocities
+  // (a rate-form thermal row does, on the position rates, which share the position columns)
   bool couples(int row, int column) const override {
     const int strains = 6 * nodes_;
     if (row < 3 * nodes_ || (column >= 3 * nodes_ && column < strains)) return false;
-    return row < strains || column < strains || (row - strains) / 6 == (column - strains) / 6;
+    const bool strainRow = row >= strains && row < firstThermal_,
+               strainColumn = column >= strains && column < firstThermal_;
+    if (strainRow && strainColumn) return (row - strains) / 6 == (column - strains) / 6;
+    return !strainRow || column < strains;
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -53,18 +67,28 @@ class SolidElement final : public Component {
   using NodePositions = Eigen::Matrix<double, 3, kMaxCellNodes>;
   // How one scheme evaluates a quadrature point (see the .cpp).
   struct PointEvaluation;
+  struct NodeTemperatures;
+  double pointTemperature(int point, const NodeTemperatures& nodes) const;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
   // Mark the evaluation of a state with an inverted cell as inadmissible.
   static void rejectInverted(LocalSystem& out);
   // Add the point's residual rows and tangent columns; materialIncrement(dC) is the change
-  // of the hyperelastic stress for a change dC of the end point's C.
+  // of the hyperelastic (and coupling) stress for a change dC of the end point's C.
   template <class MaterialIncrement>
   void assemblePoint(int point, const PointEvaluation& e, const MaterialIncrement& materialIncrement,
                      LocalSystem& out) const;
+  // The point's share of the nodal heat balances: T_a w N_a (entropy rate) and their tangent.
+  // entropyRateGradient M gives the rate's derivative with respect to node b's position j as
+  // dN_b/dX . M.col(j), with the scheme's coefficients already applied.
+  void assembleHeat(int point, const PointEvaluation& e, const Mat3& entropyRateGradient, const NodeTemperatures& nodes,
+                    LocalSystem& out) const;
 
   SolidElementSpec spec_;
   int nodes_;
+  int firstThermal_;                                    // local index of the first temperature
+  std::optional<VolumeLogarithm> coupling_;             // 3 beta K ln J, thermal cells only
+  Eigen::Matrix<double, kMaxCellNodes, 1> nodeVolume_;  // m_a = sum_q w N_a
 };
 
 }  // namespace mpx

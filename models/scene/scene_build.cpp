@@ -1,6 +1,7 @@
 #include "models/scene/scene_build.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <stdexcept>
 
@@ -174,9 +175,15 @@ std::vector<int> SceneBuild::solidNodes(ElementReader& in, const SolidPlacement&
   }
 }
 
+namespace {
+std::array<const std::vector<ElementKind>*, 5> elementFamilies() {
+  return {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds(),
+          &thermalSolidElementKinds()};
+}
+}  // namespace
+
 const ElementKind* findElementKind(const std::string& tag) {
-  for (const auto* family :
-       {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+  for (const auto* family : elementFamilies())
     for (const ElementKind& kind : *family)
       if (tag == kind.tag) return &kind;
   return nullptr;
@@ -184,8 +191,7 @@ const ElementKind* findElementKind(const std::string& tag) {
 
 std::string elementTags() {
   std::string tags;
-  for (const auto* family :
-       {&lumpedElementKinds(), &thermalElementKinds(), &multibodyElementKinds(), &solidElementKinds()})
+  for (const auto* family : elementFamilies())
     for (const ElementKind& kind : *family) tags += (tags.empty() ? "" : ", ") + std::string(kind.tag);
   return tags;
 }

@@ -65,6 +65,7 @@ struct SolidPlacement {
   int firstPositionDof;
   int velocityShift;
   std::vector<const SolidElement*> cells;
+  std::vector<int> thermalDofs;  // each node's temperature dof; empty for a purely mechanical solid
 };
 
 // A joint as later elements (joint forces) need it.
@@ -156,6 +157,15 @@ const std::vector<ElementKind>& lumpedElementKinds();
 const std::vector<ElementKind>& thermalElementKinds();
 const std::vector<ElementKind>& multibodyElementKinds();
 const std::vector<ElementKind>& solidElementKinds();
+const std::vector<ElementKind>& thermalSolidElementKinds();
+
+// A <solid>'s thermal material (heat_capacity, conductivity, expansion, reference_temperature),
+// or none when it gives no heat_capacity.
+std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
+                                                   const LameParameters& lame);
+// Take a thermal solid's nodal temperature dofs (by node) at its initial 'temperature'.
+std::vector<int> takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
+                                  std::size_t nodes);
 
 // The kind registered for `tag`, or nullptr; all tags, for messages.
 const ElementKind* findElementKind(const std::string& tag);

@@ -1,5 +1,6 @@
 // Finite-element solids and the loads, supports and joints that refer to their named surfaces
 // (docs/scene-format.md).
+#include "models/fe/heat_conduction.hpp"
 #include "models/fe/mesh_generators.hpp"
 #include "models/fe/shape_functions.hpp"
 #include "models/fe/solid_inertia.hpp"
@@ -77,29 +78,6 @@ Mesh buildMesh(const MeshSource& source, const std::string& sceneFile) {
 
 int quadraturePointsOf(const Cell& cell) { return cell.type == CellType::Hex8 ? 8 : 1; }
 
-// int N_a dA over a face at reference coordinates: a third of the area per triangle node, a
-// 2 x 2 Gauss rule on a bilinear quadrilateral.
-std::array<double, 4> faceNodeAreas(const Face& face, const std::vector<Vec3>& nodes) {
-  std::array<double, 4> area = {0, 0, 0, 0};
-  const auto& n = face.nodes;
-  if (face.count == 3) {
-    const double third = (nodes[n[1]] - nodes[n[0]]).cross(nodes[n[2]] - nodes[n[0]]).norm() / 6;
-    area = {third, third, third, 0.0};
-    return area;
-  }
-  const double g = 1 / std::sqrt(3.0);
-  for (double xi : {-g, g})
-    for (double eta : {-g, g}) {
-      const double shape[4] = {(1 - xi) * (1 - eta) / 4, (1 + xi) * (1 - eta) / 4, (1 + xi) * (1 + eta) / 4,
-                               (1 - xi) * (1 + eta) / 4};
-      const Vec3 dXi = ((1 - eta) * (nodes[n[1]] - nodes[n[0]]) + (1 + eta) * (nodes[n[2]] - nodes[n[3]])) / 4;
-      const Vec3 dEta = ((1 - xi) * (nodes[n[3]] - nodes[n[0]]) + (1 + xi) * (nodes[n[2]] - nodes[n[1]])) / 4;
-      const double jacobian = dXi.cross(dEta).norm();
-      for (int a = 0; a < 4; ++a) area[a] += shape[a] * jacobian;
-    }
-  return area;
-}
-
 std::vector<Vec3> cellNodes(const Mesh& mesh, const Cell& cell) {
   std::vector<Vec3> nodes;
   for (int a = 0; a < nodeCount(cell.type); ++a) nodes.push_back(mesh.nodes[cell.nodes[a]]);
@@ -122,6 +100,7 @@ DofDemand declareSolid(ElementReader& in, SceneBuild& build) {
   DofDemand demand{3 * static_cast<int>(mesh->nodes.size()), 0, 0, 0};
   if (in.has("viscosity"))
     for (const Cell& cell : mesh->cells) demand.internal += 6 * quadraturePointsOf(cell);
+  if (in.has("heat_capacity")) demand.thermal = static_cast<int>(mesh->nodes.size());
   return demand;
 }
 
@@ -133,9 +112,13 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   std::shared_ptr<const HyperelasticMaterial> material;
   const std::string law = in.text("material", "neo_hooke");
   std::optional<ViscousBranch> branch;
+  std::optional<ThermalMaterial> thermal;
   double density = 0.0;
   try {
-    const LameParameters lame = LameParameters::fromYoung(in.positive("young"), in.number("poisson"));
+    // elastic constants as Young's modulus and Poisson's ratio, or as the Lame constants
+    const LameParameters lame = in.has("mu") ? LameParameters{in.nonNegative("lambda", 0.0), in.positive("mu")}
+                                             : LameParameters::fromYoung(in.positive("young"), in.number("poisson"));
+    thermal = readThermalMaterial(in, build, lame);
     if (law == "neo_hooke")
       material = std::make_shared<NeoHooke>(lame);
     else if (law == "svk")
@@ -170,16 +153,18 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     high = high.cwiseMax(X);
   }
   build.keepPositionScale((high - low).norm());
+  SolidPlacement placement{name, mesh, first, shift, {}, {}};
+  if (thermal) placement.thermalDofs = takeTemperatures(in, build, dofs, *thermal, mesh->nodes.size());
 
   // one element and one inertia per cell; a node's kinematic rows belong to its first cell
   std::vector<bool> owned(mesh->nodes.size(), false);
-  SolidPlacement placement{name, mesh, first, shift, {}};
   for (std::size_t c = 0; c < mesh->cells.size(); ++c) {
     const Cell& cell = mesh->cells[c];
-    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, -1, {}, material, branch};
+    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, -1, {}, material, branch, thermal, {}};
     SolidInertiaSpec inertia{element.name + ".inertia", {}, shift, {}, {}, density, build.spec.gravity};
     for (int a = 0; a < nodeCount(cell.type); ++a) {
       element.positionDofs.push_back(first + 3 * cell.nodes[a]);
+      if (thermal) element.thermalDofs.push_back(placement.thermalDofs[cell.nodes[a]]);
       inertia.ownsNode.push_back(!owned[cell.nodes[a]]);
       owned[cell.nodes[a]] = true;
     }
@@ -195,6 +180,9 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
       element.firstInternalDof = dofs.take(Block::Internal, count);
       build.scale.segment(element.firstInternalDof, count).setConstant(kViscousStrainScale);
     }
+    if (thermal && thermal->conductivity > 0.0)
+      build.addComponent(std::make_unique<HeatConduction>(element.name + ".conduction", element.thermalDofs,
+                                                          element.points, thermal->conductivity));
     auto solidElement = std::make_unique<SolidElement>(std::move(element));
     placement.cells.push_back(solidElement.get());
     build.addComponent(std::move(solidElement));
@@ -224,15 +212,9 @@ void buildTraction(ElementReader& in, SceneBuild& build, DofRange&) {
     in.fail("give exactly one of 'traction' (force per reference area) and 'total_force'");
 
   // consistent nodal loads: traction times int N_a dA, summed over the faces
-  std::map<int, double> nodeArea;
+  const std::map<int, double> nodeArea = surfaceNodeAreas(*solid.mesh, faces->second);
   double area = 0.0;
-  for (const Face& face : faces->second) {
-    const std::array<double, 4> share = faceNodeAreas(face, solid.mesh->nodes);
-    for (int a = 0; a < face.count; ++a) {
-      nodeArea[face.nodes[a]] += share[a];
-      area += share[a];
-    }
-  }
+  for (const auto& [node, share] : nodeArea) area += share;
   const Vec3 traction =
       in.has("traction") ? in.vector("traction", Vec3::Zero()) : in.vector("total_force", Vec3::Zero()) / area;
   std::map<int, Vec3> forces;
@@ -281,7 +263,8 @@ void buildPrescribedMotion(ElementReader& in, SceneBuild& build, MotionKind kind
         in.fail("node " + std::to_string(node) + " of '" + solid.name + "' already has a prescribed motion in " +
                 direction);
       }
-      motions.push_back({dof, amplitude[k], profile, displacement});
+      motions.push_back(
+          {dof, amplitude[k], profile, displacement ? PrescribedKind::Displacement : PrescribedKind::Velocity});
       build.state[dof] = startVelocity[k];
     }
 }

@@ -36,6 +36,7 @@ void HeatLink::exchange(const Workspace& ws, LocalSystem& out, Flows& flows) con
     // heat through a prescribed temperature crosses the system boundary
     if (localThermal_[e] < 0) {
       flows.boundaryHeat -= heatIn;
+      flows.boundaryEntropy -= heatIn / node[e]->value;
       continue;
     }
     r[localThermal_[e]] -= heatIn;

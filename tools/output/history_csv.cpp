@@ -6,14 +6,21 @@
 
 namespace mpx {
 
-HistoryCsv::HistoryCsv(const std::filesystem::path& directory, const Model& model)
+HistoryCsv::HistoryCsv(const std::filesystem::path& directory, const CompiledScene& scene)
     : partPath_(directory / "history.csv.part"), finalPath_(directory / "history.csv") {
   file_ = std::fopen(partPath_.c_str(), "w");
   if (!file_) throw InputError(partPath_.string() + ": cannot create the output file");
   std::string header =
-      "time,dt,energy,entropy,dissipated_energy,external_work,boundary_heat,momentum_x,momentum_y,momentum_z,"
-      "angular_momentum_x,angular_momentum_y,angular_momentum_z,newton_iterations,cutbacks,constraint_violation";
-  for (const std::string& node : model.thermalNodeNames()) header += ",temperature_" + node;
+      "time,dt,energy,entropy,dissipated_energy,external_work,boundary_heat,boundary_entropy,entropy_production,"
+      "momentum_x,momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z,newton_iterations,"
+      "cutbacks,constraint_violation";
+  for (const std::string& node : scene.model->thermalNodeNames()) header += ",temperature_" + node;
+  for (const SolidPlacement& solid : scene.solids) {
+    if (solid.thermalDofs.empty()) continue;
+    temperatureFields_.push_back(solid.thermalDofs);
+    for (const char* statistic : {"min", "max", "mean"})
+      header += fmt::format(",temperature_{}_{}", statistic, solid.name);
+  }
   fmt::print(file_, "{}\n", header);
 }
 
@@ -23,14 +30,27 @@ HistoryCsv::~HistoryCsv() {
 
 void HistoryCsv::write(const StepRecord& r) {
   const Measures& m = *r.measures;
+  if (first_) initialEntropy_ = m.entropy;
+  first_ = false;
   fmt::print(
       file_,
-      "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},"
-      "{:.17g}",
+      "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:."
+      "17g},{:.17g},{},{},{:.17g}",
       r.time, r.dt, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat,
-      m.momentum.x(), m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(),
-      m.angularMomentum.z(), r.newtonIterations, r.cutbacks, m.constraintViolation);
+      r.crossed.boundaryEntropy, m.entropy - initialEntropy_ - r.crossed.boundaryEntropy, m.momentum.x(),
+      m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
+      r.newtonIterations, r.cutbacks, m.constraintViolation);
   for (double temperature : m.nodeTemperature) fmt::print(file_, ",{:.17g}", temperature);
+  for (const std::vector<int>& dofs : temperatureFields_) {
+    double low = INFINITY, high = -INFINITY, sum = 0.0;
+    for (int dof : dofs) {
+      const double theta = (*r.state)[dof];
+      low = std::min(low, theta);
+      high = std::max(high, theta);
+      sum += theta;
+    }
+    fmt::print(file_, ",{:.17g},{:.17g},{:.17g}", low, high, sum / static_cast<double>(dofs.size()));
+  }
   std::fputc('\n', file_);
 }
 

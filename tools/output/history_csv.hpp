@@ -1,9 +1,11 @@
 #pragma once
 // DIR/history.csv: one row per step. Written to history.csv.part and renamed when the run
 // ends, so an interrupted run never leaves a file that looks complete; a solver failure is
-// kept up to the last good step and marked by a final comment line.
+// kept up to the last good step and marked by a final comment line. Entropy production is the
+// entropy change not brought in through boundaries; thermal solids add their temperature range.
 #include "engine/core/model.hpp"
 #include "engine/stepping/simulation.hpp"
+#include "models/scene/scene_loader.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -13,7 +15,7 @@ namespace mpx {
 
 class HistoryCsv {
  public:
-  HistoryCsv(const std::filesystem::path& directory, const Model& model);
+  HistoryCsv(const std::filesystem::path& directory, const CompiledScene& scene);
   ~HistoryCsv();
   HistoryCsv(const HistoryCsv&) = delete;
   HistoryCsv& operator=(const HistoryCsv&) = delete;
@@ -24,6 +26,9 @@ class HistoryCsv {
   std::filesystem::path path() const { return finalPath_; }
 
  private:
+  std::vector<std::vector<int>> temperatureFields_;  // thermal dofs of each thermal solid
+  double initialEntropy_ = 0.0;
+  bool first_ = true;
   std::FILE* file_ = nullptr;
   std::filesystem::path partPath_, finalPath_;
 };

@@ -1,0 +1,58 @@
+#include "models/fe/heat_conduction.hpp"
+
+#include "engine/core/discrete_gradient.hpp"
+
+namespace mpx {
+
+HeatConduction::HeatConduction(std::string name, std::vector<int> thermalDofs, std::vector<CellPoint> points,
+                               double conductivity)
+    : Component(std::move(name), std::move(thermalDofs)),
+      points_(std::move(points)),
+      conductivity_(conductivity),
+      nodes_(static_cast<int>(dofs().size())) {}
+
+void HeatConduction::assemble(const ShapeValues& T, const ShapeValues& slope, LocalSystem& out) const {
+  auto r = out.residual();
+  auto K = out.tangent();
+  for (const CellPoint& p : points_) {
+    const ShapeValues& N = p.values;
+    const ShapeGradients& G = p.gradients;
+    const double theta = N.dot(T);
+    const Vec3 gradient = G.transpose() * T, flux = -conductivity_ * gradient;
+    const double fluxPower = gradient.dot(flux);  // g . Q
+    // h_a = Grad N_a . Q / theta - N_a (g . Q) / theta^2, the row is -w T_a h_a
+    for (int a = 0; a < nodes_; ++a) {
+      const double h = G.row(a).dot(flux) / theta - N[a] * fluxPower / (theta * theta);
+      r[a] -= p.weight * T[a] * h;
+      K(a, a) -= p.weight * slope[a] * h;
+      for (int b = 0; b < nodes_; ++b) {
+        // dh_a/dT_b, with dQ/dT_b = -k0 Grad N_b and d(g . Q)/dT_b = 2 Grad N_b . Q
+        const double dh =
+            -conductivity_ * G.row(a).dot(G.row(b)) / theta - G.row(a).dot(flux) * N[b] / (theta * theta) -
+            N[a] * (2.0 * G.row(b).dot(flux) / (theta * theta) - 2.0 * fluxPower * N[b] / (theta * theta * theta));
+        K(a, b) -= p.weight * T[a] * dh * slope[b];
+      }
+    }
+  }
+}
+
+void HeatConduction::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  ShapeValues T = ShapeValues::Zero(), slope = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) {
+    const LogarithmicMean mean = logarithmicMean(args.zOld[dofs()[a]], args.zNew[dofs()[a]]);
+    T[a] = mean.value;
+    slope[a] = mean.derivative;
+  }
+  assemble(T, slope, out);
+}
+
+void HeatConduction::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  ShapeValues T = ShapeValues::Zero(), slope = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) {
+    T[a] = args.z[dofs()[a]];
+    slope[a] = args.alpha;
+  }
+  assemble(T, slope, out);
+}
+
+}  // namespace mpx

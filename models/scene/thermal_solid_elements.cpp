@@ -1,0 +1,119 @@
+// Thermal fields of finite-element solids: the thermal material of a <solid>, initial and
+// prescribed temperatures, heat flux and convection on named surfaces (docs/scene-format.md,
+// "Thermal solids").
+#include "models/scene/scene_build.hpp"
+#include "models/thermal/surface_heat.hpp"
+
+#include <fmt/format.h>
+
+namespace mpx {
+
+std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
+                                                   const LameParameters& lame) {
+  if (!in.has("heat_capacity")) {
+    for (const char* attribute : {"conductivity", "expansion", "reference_temperature", "temperature"})
+      if (in.has(attribute)) in.fail(fmt::format("'{}' needs a thermal solid: give heat_capacity too", attribute));
+    return std::nullopt;
+  }
+  if (build.variable == ThermalVariable::Entropy)
+    in.fail("a thermal solid takes the temperature-based EEM only (the entropy form is not implemented for solids)");
+  ThermalMaterial m;
+  m.capacity = in.positive("heat_capacity");
+  m.conductivity = in.nonNegative("conductivity", 0.0);
+  m.expansion = in.number("expansion", 0.0);
+  m.referenceTemperature = in.positive("reference_temperature", 293.15);
+  m.bulkModulus = lame.lambda + 2.0 * lame.mu / 3.0;
+  return m;
+}
+
+std::vector<int> takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
+                                  std::size_t nodes) {
+  const double temperature = in.positive("temperature", m.referenceTemperature);
+  const int first = dofs.take(Block::Thermal, static_cast<int>(nodes));
+  std::vector<int> thermalDofs;
+  for (std::size_t n = 0; n < nodes; ++n) {
+    const int dof = first + static_cast<int>(n);
+    thermalDofs.push_back(dof);
+    build.state[dof] = temperature;
+    build.scale[dof] = m.referenceTemperature;
+  }
+  return thermalDofs;
+}
+
+namespace {
+
+// The thermal solid named by 'solid'.
+const SolidPlacement& thermalSolidOf(ElementReader& in, const SceneBuild& build) {
+  const SolidPlacement& solid = build.solidOf(in);
+  if (solid.thermalDofs.empty()) in.fail("solid '" + solid.name + "' has no temperature field (give it heat_capacity)");
+  return solid;
+}
+
+void buildInitialTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
+  const SolidPlacement& solid = thermalSolidOf(in, build);
+  const double temperature = in.positive("temperature");
+  for (int node : build.solidNodes(in, solid)) build.state[solid.thermalDofs[node]] = temperature;
+}
+
+// Dirichlet: the nodes' heat rows become theta = temperature * profile(t), and their reactions
+// are the heat that enters there.
+void buildPrescribedTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
+  const SolidPlacement& solid = thermalSolidOf(in, build);
+  const std::vector<int> nodes = build.solidNodes(in, solid);
+  const double temperature = in.positive("temperature");
+  const TimeFunction profile = readProfile(in, build);
+  if (!(profile(0.0) > 0.0)) in.fail("the prescribed temperature must be positive at t = 0");
+  for (int node : nodes) {
+    const int dof = solid.thermalDofs[node];
+    for (const PrescribedMotion& p : build.prescribedMotions)
+      if (p.dof == dof) in.fail(fmt::format("node {} of '{}' already has a prescribed temperature", node, solid.name));
+    build.prescribedMotions.push_back({dof, temperature, profile, PrescribedKind::Temperature});
+    build.state[dof] = temperature * profile(0.0);
+  }
+}
+
+// One SurfaceHeat per node of the surface, with its share of the area.
+void addSurfaceHeat(ElementReader& in, SceneBuild& build, SurfaceHeatSpec spec) {
+  const SolidPlacement& solid = thermalSolidOf(in, build);
+  const std::string surface = in.text("surface");
+  const auto faces = solid.mesh->surfaces.find(surface);
+  if (faces == solid.mesh->surfaces.end())
+    in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface '" + surface + "'");
+  const std::string name = spec.name;
+  for (const auto& [node, area] : surfaceNodeAreas(*solid.mesh, faces->second)) {
+    spec.name = name + ".node" + std::to_string(node);
+    spec.thermalDof = solid.thermalDofs[node];
+    spec.area = area;
+    build.addComponent(std::make_unique<SurfaceHeat>(spec));
+  }
+}
+
+void buildHeatFlux(ElementReader& in, SceneBuild& build, DofRange&) {
+  SurfaceHeatSpec spec;
+  spec.name = build.declareName(in);
+  spec.flux = in.number("flux");
+  spec.profile = readProfile(in, build);
+  addSurfaceHeat(in, build, spec);
+}
+
+void buildConvection(ElementReader& in, SceneBuild& build, DofRange&) {
+  SurfaceHeatSpec spec;
+  spec.name = build.declareName(in);
+  spec.convection = in.positive("coefficient");
+  spec.ambientTemperature = in.positive("ambient");
+  addSurfaceHeat(in, build, spec);
+}
+
+}  // namespace
+
+const std::vector<ElementKind>& thermalSolidElementKinds() {
+  static const std::vector<ElementKind> kinds = {
+      {"initial_temperature", nullptr, buildInitialTemperature},
+      {"prescribed_temperature", nullptr, buildPrescribedTemperature},
+      {"heat_flux", nullptr, buildHeatFlux},
+      {"convection", nullptr, buildConvection},
+  };
+  return kinds;
+}
+
+}  // namespace mpx
