@@ -128,7 +128,8 @@ class StepLoopAllocation : public testing::TestWithParam<std::tuple<std::string,
 
 // Zero allocations and releases over 200 steps of every scheme on the thermo-mechanical
 // benchmark scenes (with heat links, internal variables and both thermal variables), a rigid
-// multibody scene and an FE solid (viscoelastic cells, joints to a body, gravity).
+// multibody scene, an FE solid (viscoelastic cells, joints to a body, gravity) and a thermal
+// one (temperatures, conduction, viscous heating, convection).
 TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
   const auto& [sceneFile, scheme] = GetParam();
   const SteppingResult result = countStepLoopTraffic(sceneFile, scheme);
@@ -139,7 +140,8 @@ TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
 
 INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,
                          testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
-                                                          "damped_double_pendulum.xml", "flexible_pendulum.xml"),
+                                                          "damped_double_pendulum.xml", "flexible_pendulum.xml",
+                                                          "cooled_flexible_pendulum.xml"),
                                           testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal)),
                          [](const testing::TestParamInfo<StepLoopAllocation::ParamType>& info) {
                            std::string scene = std::get<0>(info.param);

@@ -416,10 +416,10 @@ INSTANTIATE_TEST_SUITE_P(Cli, BadOptionsTest, ::testing::ValuesIn(kBadOptions),
 void expectCompleteHistory(const std::vector<std::string>& lines, std::size_t rows) {
   ASSERT_EQ(lines.size(), rows + 1);
   const std::vector<std::string> header = splitFields(lines.front());
-  for (const char* column :
-       {"time", "energy", "entropy", "dissipated_energy", "external_work", "boundary_heat", "momentum_x", "momentum_y",
-        "momentum_z", "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "newton_iterations", "cutbacks",
-        "constraint_violation", "temperature_spring", "temperature_wall"})
+  for (const char* column : {"time", "energy", "entropy", "dissipated_energy", "external_work", "boundary_heat",
+                             "boundary_entropy", "entropy_production", "momentum_x", "momentum_y", "momentum_z",
+                             "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "newton_iterations",
+                             "cutbacks", "constraint_violation", "temperature_spring", "temperature_wall"})
     EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
   for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(splitFields(lines[i]).size(), header.size()) << lines[i];
 }

@@ -1,6 +1,7 @@
 // Hard cases for the finite-element solids: the tumbling L-block at steps where the implicit
 // midpoint rule blows up or fails while EEM keeps the energy, and the nearly incompressible
-// L-block (Poisson 0.495), whose stiff volumetric response EEM carries through every step.
+// L-block (Poisson 0.495), whose stiff volumetric response EEM carries through every step, and
+// a thermoelastic bar heated from 273 K to 500 K at one end at a step equal to its diffusion time.
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -100,6 +101,51 @@ TEST(RefinedLBlock, EemConservesEnergyAndMomentaAtLevelTwo) {
   EXPECT_LE(energy, 1e-9);
   EXPECT_LE(momentum, 1e-9);
   EXPECT_LE(angular, 1e-9);
+}
+
+// 12. A thermoelastic bar at 273 K whose end is held at 500 K, stepped at dt = 1 = its diffusion
+// time kappa L^2 / k0 (16 cells: the stiffest mode decays 1000 times faster). EEM keeps the
+// energy balance with the boundary heat, produces entropy at every step and keeps every
+// temperature positive and bounded; midpoint destroys entropy in some step and trapezoidal
+// undershoots the initial temperature (to a negative one on this mesh).
+const char* const kHotBar = R"(<metriplex name="hot_bar"><simulation dt="1" t_end="20"/>
+  <solid name="bar" mesh="box" size="1 0.1 0.1" cells="16 1 1" young="1000" poisson="0.3" density="1"
+         heat_capacity="1" conductivity="1" expansion="1e-3" reference_temperature="273" temperature="273"/>
+  <prescribed_temperature solid="bar" surface="x0" temperature="500"/></metriplex>)";
+
+struct HotBarFigures {
+  double lowest = INFINITY, highest = 0.0, leastProduction = INFINITY, balance = 0.0;
+};
+
+HotBarFigures hotBarFigures(const CompiledScene& scene, const History& h) {
+  HotBarFigures f;
+  for (std::size_t n = 0; n < h.states.size(); ++n) {
+    for (int dof : scene.solids.front().thermalDofs) {
+      f.lowest = std::min(f.lowest, h.states[n][dof]);
+      f.highest = std::max(f.highest, h.states[n][dof]);
+    }
+    if (n == 0) continue;
+    f.leastProduction = std::min(f.leastProduction,
+                                 h.entropy[n] - h.entropy[n - 1] - (h.boundaryEntropy[n] - h.boundaryEntropy[n - 1]));
+    f.balance = std::max(f.balance, std::abs(h.energy[n] - h.energy[0] - h.boundaryHeat[n] - h.externalWork[n]));
+  }
+  return f;
+}
+
+TEST(HotBarHard, EemStaysPhysicalAtAStepOfTheDiffusionTime) {
+  const CompiledScene scene = loadSceneText(kHotBar, "hot_bar.xml");
+  const HotBarFigures eem = hotBarFigures(scene, run(*scene.model, Scheme::Eem, 1.0, 20.0));
+  const HotBarFigures midpoint = hotBarFigures(scene, run(*scene.model, Scheme::Midpoint, 1.0, 20.0));
+  const HotBarFigures trapezoidal = hotBarFigures(scene, run(*scene.model, Scheme::Trapezoidal, 1.0, 20.0));
+  for (const auto& [name, f] : {std::pair{"EEM", eem}, {"midpoint", midpoint}, {"trapezoidal", trapezoidal}})
+    std::printf("%-12s temperatures in [%.1f, %.1f] K, least production %.2e, balance error %.2e\n", name, f.lowest,
+                f.highest, f.leastProduction, f.balance);
+  EXPECT_GE(eem.lowest, 273.0 - 1e-9);
+  EXPECT_LT(eem.highest, 1000.0);
+  EXPECT_GE(eem.leastProduction, 0.0);
+  EXPECT_LT(eem.balance, 1e-10 * 500.0 * 0.01);  // heat capacity 0.01 J/K: about 2.3 J cross
+  EXPECT_LT(midpoint.leastProduction, 0.0);
+  EXPECT_LT(trapezoidal.lowest, 273.0 - 1.0);
 }
 
 }  // namespace

@@ -108,9 +108,12 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 }
 
 // The tumbling L-block of scenes/lblock_elastic.xml (Neo-Hooke, two opposite dead tractions
-// with the hat profile of period 5) on mesh level `level`; `viscous` adds the Maxwell branch
-// of scenes/lblock_viscoelastic.xml.
-SceneSpec lblock(int level, bool viscous, double dt) {
+// with the hat profile of period 5) on mesh level `level`; Viscoelastic adds the Maxwell branch
+// of scenes/lblock_viscoelastic.xml, Thermoelastic the thermal field of
+// scenes/lblock_thermoelastic.xml (same elastic constants, so only the thermal part differs).
+enum class LBlockVariant { Elastic, Viscoelastic, Thermoelastic };
+
+SceneSpec lblock(int level, LBlockVariant variant, double dt) {
   SceneSpec scene = generatedScene("lblock", dt, 50);
   ElementSpec& block = scene.add("solid", {{"name", "block"},
                                            {"mesh", "lblock"},
@@ -119,7 +122,13 @@ SceneSpec lblock(int level, bool viscous, double dt) {
                                            {"young", 2.26115e3},
                                            {"poisson", 0.395469},
                                            {"density", 10.0}});
-  if (viscous) block.set("branch_lambda", 227.2).set("branch_mu", 49.875).set("viscosity", 100.0);
+  if (variant == LBlockVariant::Viscoelastic)
+    block.set("branch_lambda", 227.2).set("branch_mu", 49.875).set("viscosity", 100.0);
+  if (variant == LBlockVariant::Thermoelastic) {
+    block.set("heat_capacity", 100.0).set("conductivity", 10.0).set("expansion", 2.233e-4);
+    for (const auto& [surface, temperature] : {std::pair{"load_y10", 313.15}, std::pair{"load_x6", 273.15}})
+      scene.add("initial_temperature", {{"solid", "block"}, {"surface", surface}, {"temperature", temperature}});
+  }
   for (const auto& [name, surface, sign] :
        {std::tuple{"push_top", "load_y10", 1.0}, std::tuple{"push_side", "load_x6", -1.0}})
     scene.add("traction", {{"name", name},
@@ -326,9 +335,9 @@ void loadedSolidBenchmark(benchmark::State& state, const std::shared_ptr<LoadedS
 // Register the EEM step (dt 0.1) of the L-block at mesh level `level` in its loaded phase:
 // from a state at t = 1 (a fifth into the load, reached by two steps of 0.5), `steps` timed
 // steps per run.
-void registerLBlock(const std::string& name, int level, bool viscous, int steps) {
+void registerLBlock(const std::string& name, int level, LBlockVariant variant, int steps) {
   auto solid = std::make_shared<LoadedSolid>();
-  solid->scene = std::make_shared<const CompiledScene>(compileScene(lblock(level, viscous, 0.1)));
+  solid->scene = std::make_shared<const CompiledScene>(compileScene(lblock(level, variant, 0.1)));
   solid->loadedTime = 1.0;
   solid->loadingDt = 0.5;
   benchmark::RegisterBenchmark((name + "/level" + std::to_string(level) + "/eem").c_str(), loadedSolidBenchmark, solid)
@@ -354,12 +363,15 @@ int main(int argc, char** argv) {
   registerCases("rigid_chain_50_penalty", sceneSpec(rigidChain(50, Enforcement::Penalty, 1e8, 1e-3)), {kEem});
   registerCases("slider_crank_spatial", sceneFile("slider_crank_spatial.xml"), {kEem, kMidpoint});
   // finite-element solids: the tumbling L-block by mesh level (90 to 14 400 nodes)
-  registerLBlock("lblock_elastic", 1, false, 20);
-  registerLBlock("lblock_elastic", 2, false, 20);
-  registerLBlock("lblock_elastic", 4, false, 10);
-  registerLBlock("lblock_elastic", 7, false, 2);  // one to two minutes: seconds per Newton iteration
-  registerLBlock("lblock_viscoelastic", 1, true, 20);
-  registerLBlock("lblock_viscoelastic", 2, true, 10);
+  registerLBlock("lblock_elastic", 1, LBlockVariant::Elastic, 20);
+  registerLBlock("lblock_elastic", 2, LBlockVariant::Elastic, 20);
+  registerLBlock("lblock_elastic", 4, LBlockVariant::Elastic, 10);
+  registerLBlock("lblock_elastic", 7, LBlockVariant::Elastic, 2);  // one to two minutes: seconds per Newton iteration
+  registerLBlock("lblock_viscoelastic", 1, LBlockVariant::Viscoelastic, 20);
+  registerLBlock("lblock_viscoelastic", 2, LBlockVariant::Viscoelastic, 10);
+  registerLBlock("lblock_thermoelastic", 1, LBlockVariant::Thermoelastic, 20);
+  registerLBlock("lblock_thermoelastic", 2, LBlockVariant::Thermoelastic, 20);
+  registerLBlock("lblock_thermoelastic", 4, LBlockVariant::Thermoelastic, 10);
 
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -84,6 +84,7 @@ Mesh makeBoxMesh(const Vec3& origin, const Vec3& size, const std::array<int, 3>&
     mesh.surfaces[axisNames[axis] + "0"] = facesOnPlane(mesh, boundary, axis, lines[axis].front());
     mesh.surfaces[axisNames[axis] + "1"] = facesOnPlane(mesh, boundary, axis, lines[axis].back());
   }
+  mesh.surfaces["boundary"] = boundary;
   return mesh;
 }
 

@@ -5,7 +5,8 @@
 namespace mpx {
 
 // Box [origin, origin+size] split in cells[0] x cells[1] x cells[2] hexahedra. Surfaces named
-// "x0","x1","y0","y1","z0","z1" (faces at min/max of each axis), volume "all".
+// "x0","x1","y0","y1","z0","z1" (faces at min/max of each axis) and "boundary" (all of them),
+// volume "all".
 Mesh makeBoxMesh(const Vec3& origin, const Vec3& size, const std::array<int, 3>& cells);
 
 // Tumbling L-block of Simo & Tarnow (docs/theory.md section 11.3): short leg x in [0,6], y in [0,3], z in [0,3]; long

@@ -340,4 +340,21 @@ Mat3 SolidElement::meanViscousStrain(const double* z) const {
   return sum / static_cast<double>(spec_.points.size());
 }
 
+Vec3 SolidElement::meanHeatFlux(const double* z) const {
+  Vec3 sum = Vec3::Zero();
+  if (!spec_.thermal) return sum;
+  ShapeValues theta = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) theta[a] = z[spec_.thermalDofs[a]];
+  for (const CellPoint& p : spec_.points) sum -= spec_.thermal->conductivity * p.gradients.transpose() * theta;
+  return sum / static_cast<double>(spec_.points.size());
+}
+
+double SolidElement::meanTemperature(const double* z) const {
+  double sum = 0.0;
+  if (!spec_.thermal) return sum;
+  for (const CellPoint& p : spec_.points)
+    for (int a = 0; a < nodes_; ++a) sum += p.values[a] * z[spec_.thermalDofs[a]];
+  return sum / static_cast<double>(spec_.points.size());
+}
+
 }  // namespace mpx

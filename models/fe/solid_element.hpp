@@ -62,6 +62,10 @@ class SolidElement final : public Component {
   // Cauchy stress and viscous strain averaged over the quadrature points (for output).
   Mat3 meanCauchyStress(const double* z) const;
   Mat3 meanViscousStrain(const double* z) const;
+  // Heat flux -k0 Grad theta and temperature averaged over the quadrature points (0 for a
+  // mechanical cell).
+  Vec3 meanHeatFlux(const double* z) const;
+  double meanTemperature(const double* z) const;
 
  private:
   using NodePositions = Eigen::Matrix<double, 3, kMaxCellNodes>;

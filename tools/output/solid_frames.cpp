@@ -45,18 +45,32 @@ void SolidFrames::write(const StepRecord& record) {
       velocity.values.insert(velocity.values.end(), {z[dof + solid.velocityShift], z[dof + solid.velocityShift + 1],
                                                      z[dof + solid.velocityShift + 2]});
     }
+    std::vector<VtkField> nodeFields = {displacement, velocity};
+    const bool thermal = !solid.thermalDofs.empty();
+    if (thermal) {
+      VtkField temperature{"temperature", 1, {}};
+      for (int dof : solid.thermalDofs) temperature.values.push_back(z[dof]);
+      nodeFields.push_back(std::move(temperature));
+    }
     VtkField stress{"cauchy_stress", 6, {}}, vonMises{"von_mises", 1, {}}, viscous{"viscous_strain", 6, {}};
+    VtkField heatFlux{"heat_flux", 3, {}}, cellTemperature{"temperature", 1, {}};
     for (const SolidElement* cell : solid.cells) {
       const Mat3 sigma = cell->meanCauchyStress(z);
       appendSymmetric(sigma, stress.values);
       vonMises.values.push_back(vonMisesOf(sigma));
       appendSymmetric(cell->meanViscousStrain(z), viscous.values);
+      const Vec3 flux = cell->meanHeatFlux(z);
+      heatFlux.values.insert(heatFlux.values.end(), {flux.x(), flux.y(), flux.z()});
+      cellTemperature.values.push_back(cell->meanTemperature(z));
     }
+    std::vector<VtkField> cellFields = {stress, vonMises, viscous};
+    if (thermal) cellFields.push_back(heatFlux);
     const std::string file = fmt::format("{}/frame_{:05d}.vtu", solid.name, frame_);
-    writeVtu((directory_ / file).string(), mesh, s.positions, {displacement, velocity}, {stress, vonMises, viscous});
+    writeVtu((directory_ / file).string(), mesh, s.positions, nodeFields, cellFields);
     s.pvd.add(record.time, file);
     s.pvd.write();
-    s.vonMises = vonMises.values;
+    // the picture shows a thermal solid's temperature, a mechanical one's von Mises stress
+    s.picture = thermal ? cellTemperature.values : vonMises.values;
     s.time = record.time;
   }
   ++frame_;
@@ -66,7 +80,8 @@ void SolidFrames::finish() {
   for (const Series& s : series_) {
     const std::filesystem::path png = directory_ / (s.solid->name + ".png");
     try {
-      renderSurfacePng(png.string(), *s.solid->mesh, s.positions, s.vonMises, "von Mises stress",
+      renderSurfacePng(png.string(), *s.solid->mesh, s.positions, s.picture,
+                       s.solid->thermalDofs.empty() ? "von Mises stress" : "temperature (K)",
                        fmt::format("{} at t = {:.4g}", s.solid->name, s.time));
     } catch (const std::exception& error) {
       fmt::print(stderr, "metriplex: warning: no picture of '{}': {}\n", s.solid->name, error.what());

@@ -1,8 +1,9 @@
 #pragma once
 // ParaView output of the finite-element solids of a run: DIR/<solid>.pvd listing
-// DIR/<solid>/frame_<k>.vtu (displacement and velocity at nodes; Cauchy stress, von Mises
-// stress and viscous strain per cell), one frame per output interval, and at the end a
-// picture of the last frame, DIR/<solid>.png, coloured by the von Mises stress.
+// DIR/<solid>/frame_<k>.vtu (displacement, velocity and, for a thermal solid, temperature at
+// nodes; Cauchy stress, von Mises stress, viscous strain and heat flux per cell), one frame per
+// output interval, and at the end a picture of the last frame, DIR/<solid>.png, coloured by
+// the temperature of a thermal solid or else by the von Mises stress.
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
 #include "tools/output/vtk_writer.hpp"
@@ -25,7 +26,7 @@ class SolidFrames {
     const SolidPlacement* solid;
     PvdSeries pvd;
     std::vector<Vec3> positions;  // of the last frame written
-    std::vector<double> vonMises;
+    std::vector<double> picture;  // the last frame's cell values the picture is coloured by
     double time = 0.0;
   };
   std::filesystem::path directory_;
