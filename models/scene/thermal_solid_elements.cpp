@@ -3,6 +3,7 @@
 // "Thermal solids").
 #include "models/scene/scene_build.hpp"
 #include "models/thermal/surface_heat.hpp"
+#include "models/thermal/surface_heat_link.hpp"
 
 #include <fmt/format.h>
 
@@ -72,15 +73,20 @@ void buildPrescribedTemperature(ElementReader& in, SceneBuild& build, DofRange&)
   }
 }
 
-// One SurfaceHeat per node of the surface, with its share of the area.
-void addSurfaceHeat(ElementReader& in, SceneBuild& build, SurfaceHeatSpec spec) {
-  const SolidPlacement& solid = thermalSolidOf(in, build);
+// int N_a dA of each node of the thermal solid's surface named by 'surface'.
+std::map<int, double> thermalSurfaceAreas(ElementReader& in, const SolidPlacement& solid) {
   const std::string surface = in.text("surface");
   const auto faces = solid.mesh->surfaces.find(surface);
   if (faces == solid.mesh->surfaces.end())
     in.fail("attribute 'surface': the mesh of '" + solid.name + "' has no surface '" + surface + "'");
+  return surfaceNodeAreas(*solid.mesh, faces->second);
+}
+
+// One SurfaceHeat per node of the surface, with its share of the area.
+void addSurfaceHeat(ElementReader& in, SceneBuild& build, SurfaceHeatSpec spec) {
+  const SolidPlacement& solid = thermalSolidOf(in, build);
   const std::string name = spec.name;
-  for (const auto& [node, area] : surfaceNodeAreas(*solid.mesh, faces->second)) {
+  for (const auto& [node, area] : thermalSurfaceAreas(in, solid)) {
     spec.name = name + ".node" + std::to_string(node);
     spec.thermalDof = solid.thermalDofs[node];
     spec.area = area;
@@ -104,6 +110,17 @@ void buildConvection(ElementReader& in, SceneBuild& build, DofRange&) {
   addSurfaceHeat(in, build, spec);
 }
 
+// One SurfaceHeatLink per node of the surface to the lumped thermal node 'node'.
+void buildSurfaceHeatLink(ElementReader& in, SceneBuild& build, DofRange&) {
+  const std::string name = build.declareName(in);
+  const SolidPlacement& solid = thermalSolidOf(in, build);
+  const ThermalNodeRef lumped = build.thermalNode(in, "node");
+  const double coefficient = in.positive("coefficient");
+  for (const auto& [node, area] : thermalSurfaceAreas(in, solid))
+    build.addComponent(std::make_unique<SurfaceHeatLink>(name + ".node" + std::to_string(node), solid.thermalDofs[node],
+                                                         lumped, coefficient * area));
+}
+
 }  // namespace
 
 const std::vector<ElementKind>& thermalSolidElementKinds() {
@@ -112,6 +129,7 @@ const std::vector<ElementKind>& thermalSolidElementKinds() {
       {"prescribed_temperature", nullptr, buildPrescribedTemperature},
       {"heat_flux", nullptr, buildHeatFlux},
       {"convection", nullptr, buildConvection},
+      {"surface_heat_link", nullptr, buildSurfaceHeatLink},
   };
   return kinds;
 }
