@@ -459,6 +459,33 @@ TEST_F(CliTest, SolidRunWritesAParaViewSeriesAndAPicture) {
     EXPECT_NE(entry.path().extension(), ".part") << entry.path();
 }
 
+// A thermal solid adds its temperature range to history.csv and temperature and heat flux to
+// its frames; the held face's heat and entropy are accumulated
+TEST_F(CliTest, ThermalSolidRunWritesTemperaturesAndBoundaryColumns) {
+  const std::string scene = sceneWith(
+      "  <solid name=\"block\" mesh=\"box\" size=\"2 1 1\" cells=\"2 1 1\" young=\"1000\" poisson=\"0.3\" "
+      "density=\"10\" heat_capacity=\"10\" conductivity=\"5\" temperature=\"300\"/>\n"
+      "  <prescribed_temperature solid=\"block\" surface=\"x0\" temperature=\"350\"/>");
+  const Invocation r =
+      metriplex("run " + quoted(writeScene(scene)) + " --output-interval 0.5 --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "history.csv"));
+  const std::vector<std::string> header = splitFields(lines.front());
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return std::stod(splitFields(lines.back())[it - header.begin()]);
+  };
+  EXPECT_EQ(column("temperature_max_block"), 350.0);
+  EXPECT_GT(column("temperature_min_block"), 300.0);
+  EXPECT_GT(column("boundary_heat"), 0.0);
+  EXPECT_GT(column("boundary_entropy"), 0.0);
+  EXPECT_GT(column("entropy_production"), 0.0);
+  const std::string vtu = readFile(outDir() / "block" / "frame_00002.vtu");
+  for (const char* field : {"\"temperature\"", "\"heat_flux\""})
+    EXPECT_NE(vtu.find(field), std::string::npos) << "frame lacks " << field;
+}
+
 // --dt and --t-end replace the scene's step and end time
 TEST_F(CliTest, StepAndEndTimeOptionsOverrideTheScene) {
   const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) +
