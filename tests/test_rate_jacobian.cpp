@@ -52,7 +52,7 @@ INSTANTIATE_TEST_SUITE_P(FixtureScenes, RateJacobian,
                                            "heavy_top.xml", "free_floating_chain.xml", "two_thermo_springs.xml",
                                            "thermo_visco_elastic.xml", "damped_pendulum_spring.xml",
                                            "double_pendulum_penalty.xml", "damped_robot_arm.xml",
-                                           "stiff_thermo_chain.xml", "heated_thermo_spring.xml"),
+                                           "stiff_thermo_chain.xml", "heated_thermo_spring.xml", "thermal_block.xml"),
                          [](const auto& info) {
                            std::string name = info.param;
                            return name.substr(0, name.find('.'));

@@ -85,6 +85,7 @@ struct ThermalMaterial {
   double capacity = 1.0;              // kappa, heat capacity per reference volume (J/(m^3 K))
   double conductivity = 0.0;          // k0 (W/(m K))
   double referenceTemperature = 1.0;  // theta_R (K)
+  double viscosityActivation = 0.0;   // a of a Maxwell branch's eta(theta) = eta exp(-a (theta - theta_R)) (1/K)
   double couplingModulus() const { return 3.0 * expansion * bulkModulus; }
 };
 

@@ -4,7 +4,9 @@
 
 #include "engine/core/discrete_gradient.hpp"
 
+#include <cmath>
 #include <limits>
+#include <optional>
 
 namespace mpx {
 
@@ -52,6 +54,8 @@ struct SolidElement::PointEvaluation {
   ShapeValues temperatureSlope = ShapeValues::Zero();
   Mat3 couplingStress = Mat3::Zero();
   double entropyRate = 0.0;
+  // the branch's fluidity 1/eta at the point's temperature and its derivative in that temperature
+  double fluidity = 0.0, fluiditySlope = 0.0;
 };
 
 // The nodal temperatures T_a the heat rows are weighted with and their derivatives dT_a/dtheta_a.
@@ -68,6 +72,17 @@ SolidElement::SolidElement(SolidElementSpec spec)
   nodeVolume_.setZero();
   for (const CellPoint& p : spec_.points) nodeVolume_ += p.weight * p.values;
   if (spec_.thermal) coupling_.emplace(spec_.thermal->couplingModulus());
+}
+
+// eta(theta) = eta_R exp(-a (theta - theta_R)) at the point's temperature (constant without a
+// thermal field)
+void SolidElement::setFluidity(PointEvaluation& e) const {
+  if (!spec_.branch) return;
+  e.fluidity = 1.0 / spec_.branch->viscosity;
+  if (!spec_.thermal) return;
+  const double activation = spec_.thermal->viscosityActivation;
+  e.fluidity *= std::exp(activation * (e.temperature - spec_.thermal->referenceTemperature));
+  e.fluiditySlope = activation * e.fluidity;
 }
 
 double SolidElement::pointTemperature(int q, const NodeTemperatures& nodes) const {
@@ -123,7 +138,7 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
   const ShapeGradients& G = spec_.points[q].gradients;
   const double w = spec_.points[q].weight, s = e.tangentScale;
   const int momentumRow = 3 * nodes_, gammaRow = 6 * nodes_ + 6 * q;
-  const double fluidity = spec_.branch ? 1.0 / spec_.branch->viscosity : 0.0;
+  const double fluidity = e.fluidity;
 
   // nodal forces w F S dN_a/dX, and the branch's evolution rows
   const Mat3 firstPiola = w * e.forceGradient * e.stress;
@@ -160,13 +175,22 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
         K.block<3, 1>(momentumRow + 3 * a, 3 * b + j) += s * dPiola * G.row(a).transpose();
     }
 
-  // columns of the temperatures: the coupling stress changes by -dtheta S_L
+  // columns of the temperatures: the coupling stress changes by -dtheta S_L, the branch's
+  // flow and heating by dfluidity
   if (spec_.thermal) {
     const Mat3 dPiola = -w * e.forceGradient * e.couplingStress;
-    for (int b = 0; b < nodes_; ++b)
-      for (int a = 0; a < nodes_; ++a)
+    const double heatingPerFluidity = w * contract(e.branchStress, e.branchStress);
+    for (int b = 0; b < nodes_; ++b) {
+      const double dFluidity = s * e.fluiditySlope * e.temperatureSlope[b];
+      for (int a = 0; a < nodes_; ++a) {
         K.block<3, 1>(momentumRow + 3 * a, firstThermal_ + b) +=
             s * e.temperatureSlope[b] * dPiola * G.row(a).transpose();
+        K(firstThermal_ + a, firstThermal_ + b) -= spec_.points[q].values[a] * heatingPerFluidity * dFluidity;
+      }
+      if (spec_.branch)
+        for (int k = 0; k < 6; ++k)
+          K(gammaRow + k, firstThermal_ + b) -= dFluidity * e.branchStress(kComponent[k][0], kComponent[k][1]);
+    }
   }
   if (!spec_.branch) return;
 
@@ -190,8 +214,7 @@ void SolidElement::assembleHeat(int q, const PointEvaluation& e, const Mat3& ent
   auto r = out.residual();
   auto K = out.tangent();
   const CellPoint& p = spec_.points[q];
-  const double heating =
-      spec_.branch ? p.weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity : 0.0;
+  const double heating = p.weight * contract(e.branchStress, e.branchStress) * e.fluidity;
   for (int a = 0; a < nodes_; ++a) {
     const int row = firstThermal_ + a;
     const double share = p.weight * p.values[a];
@@ -245,6 +268,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
       e.entropyRate = coupling_->energyDifference(C0, C1) / args.dt;
       entropyRateGradient = spec_.thermal->couplingModulus() / args.dt * F1.inverse();
     }
+    setFluidity(e);
     assemblePoint(
         q, e,
         [&](const Mat3& dC) {
@@ -302,6 +326,7 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
       e.entropyRate = modulus * (inverse * rate).trace();
       entropyRateGradient = modulus * (args.beta * inverse - args.alpha * inverse * rate * inverse);
     }
+    setFluidity(e);
     assemblePoint(
         q, e,
         [&](const Mat3& dC) {

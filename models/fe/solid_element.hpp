@@ -45,7 +45,8 @@ class SolidElement final : public Component {
   explicit SolidElement(SolidElementSpec spec);
 
   // momentum and thermal rows depend on positions, strains and temperatures, the viscous rows
-  // of a point on positions and that point's own strains; nothing depends on velocities
+  // of a point on positions, temperatures (through the viscosity) and that point's own strains;
+  // nothing depends on velocities
   // (a rate-form thermal row does, on the position rates, which share the position columns)
   bool couples(int row, int column) const override {
     const int strains = 6 * nodes_;
@@ -53,7 +54,7 @@ class SolidElement final : public Component {
     const bool strainRow = row >= strains && row < firstThermal_,
                strainColumn = column >= strains && column < firstThermal_;
     if (strainRow && strainColumn) return (row - strains) / 6 == (column - strains) / 6;
-    return !strainRow || column < strains;
+    return !strainRow || column < strains || column >= firstThermal_;
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -73,6 +74,7 @@ class SolidElement final : public Component {
   struct PointEvaluation;
   struct NodeTemperatures;
   double pointTemperature(int point, const NodeTemperatures& nodes) const;
+  void setFluidity(PointEvaluation& e) const;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
   // Mark the evaluation of a state with an inverted cell as inadmissible.

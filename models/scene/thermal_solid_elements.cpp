@@ -12,7 +12,8 @@ namespace mpx {
 std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
                                                    const LameParameters& lame) {
   if (!in.has("heat_capacity")) {
-    for (const char* attribute : {"conductivity", "expansion", "reference_temperature", "temperature"})
+    for (const char* attribute :
+         {"conductivity", "expansion", "reference_temperature", "temperature", "viscosity_activation"})
       if (in.has(attribute)) in.fail(fmt::format("'{}' needs a thermal solid: give heat_capacity too", attribute));
     return std::nullopt;
   }
@@ -23,6 +24,9 @@ std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const Scen
   m.conductivity = in.nonNegative("conductivity", 0.0);
   m.expansion = in.number("expansion", 0.0);
   m.referenceTemperature = in.positive("reference_temperature", 293.15);
+  if (in.has("viscosity_activation") && !in.has("viscosity"))
+    in.fail("'viscosity_activation' needs a viscous branch: give viscosity too");
+  m.viscosityActivation = in.number("viscosity_activation", 0.0);
   m.bulkModulus = lame.lambda + 2.0 * lame.mu / 3.0;
   return m;
 }
