@@ -129,7 +129,8 @@ class StepLoopAllocation : public testing::TestWithParam<std::tuple<std::string,
 // Zero allocations and releases over 200 steps of every scheme on the thermo-mechanical
 // benchmark scenes (with heat links, internal variables and both thermal variables), a rigid
 // multibody scene, an FE solid (viscoelastic cells, joints to a body, gravity) and a thermal
-// one (temperatures, conduction, viscous heating, convection).
+// one linked to a reservoir on joints (temperatures, conduction, viscous heating), and a thermal
+// block with every boundary (Dirichlet, flux, convection, link).
 TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
   const auto& [sceneFile, scheme] = GetParam();
   const SteppingResult result = countStepLoopTraffic(sceneFile, scheme);
@@ -141,7 +142,7 @@ TEST_P(StepLoopAllocation, AllocatesNothingAfterWarmUp) {
 INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,
                          testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
                                                           "damped_double_pendulum.xml", "flexible_pendulum.xml",
-                                                          "cooled_flexible_pendulum.xml"),
+                                                          "cooled_flexible_pendulum.xml", "thermal_block.xml"),
                                           testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal)),
                          [](const testing::TestParamInfo<StepLoopAllocation::ParamType>& info) {
                            std::string scene = std::get<0>(info.param);

@@ -24,7 +24,7 @@ namespace {
 // Models up to this many unknowns use a dense Jacobian; larger ones a sparse one.
 constexpr int kLargestDenseSystem = 64;
 // The energies crossing the boundary, integrated as IDA quadratures (outside the Newton system
-// and the error test): dissipated, external work, boundary heat.
+// and the error test): dissipated, external work, boundary heat, boundary entropy.
 constexpr int kQuadratures = 4;
 // Absolute tolerance of the multipliers (forces, in the model's units) in IDA's Newton test;
 // they are left out of the error test, and the GGL multiplier mu stays at round-off, so a

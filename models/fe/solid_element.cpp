@@ -74,6 +74,22 @@ SolidElement::SolidElement(SolidElementSpec spec)
   if (spec_.thermal) coupling_.emplace(spec_.thermal->couplingModulus());
 }
 
+// Without a thermal field the branch's dissipation leaves the system; with one it heats the
+// cell's nodes instead (assembleHeat).
+void SolidElement::addDissipation(int q, const PointEvaluation& e, Flows& flows) const {
+  if (!spec_.thermal)
+    flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+}
+
+void SolidElement::addHeatCapacity(const ShapeValues& rates, double rateCoefficient, LocalSystem& out) const {
+  for (int a = 0; a < nodes_; ++a) {
+    const int row = firstThermal_ + a;
+    const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
+    out.r[row] += capacity * rates[a];
+    out.tangent()(row, row) += capacity * rateCoefficient;
+  }
+}
+
 // eta(theta) = eta_R exp(-a (theta - theta_R)) at the point's temperature (constant without a
 // thermal field)
 void SolidElement::setFluidity(PointEvaluation& e) const {
@@ -250,8 +266,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
       e.branchStress = spec_.branch->stress(0.5 * (C0 + C1), 0.5 * (gamma0 + gamma1));
       e.stress += e.branchStress;
       e.gammaRate = (gamma1 - gamma0) / args.dt;
-      if (!spec_.thermal)
-        flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+      addDissipation(q, e, flows);
     }
     // the coupling stress acts at the point's discrete temperature, with the Gonzalez stress of
     // 3 beta K ln J; the coupling entropy's change is exact
@@ -280,13 +295,12 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
     if (spec_.thermal) assembleHeat(q, e, entropyRateGradient, nodes, out);
   }
   // the heat capacity: m_a kappa (theta_a' - theta_a) = T_a m_a kappa ln(theta_a'/theta_a)
-  if (spec_.thermal)
-    for (int a = 0; a < nodes_; ++a) {
-      const int row = firstThermal_ + a, dof = spec_.thermalDofs[a];
-      const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
-      out.r[row] += capacity * (args.zNew[dof] - args.zOld[dof]) / args.dt;
-      out.tangent()(row, row) += capacity / args.dt;
-    }
+  if (spec_.thermal) {
+    ShapeValues rates = ShapeValues::Zero();
+    for (int a = 0; a < nodes_; ++a)
+      rates[a] = (args.zNew[spec_.thermalDofs[a]] - args.zOld[spec_.thermalDofs[a]]) / args.dt;
+    addHeatCapacity(rates, 1.0 / args.dt, out);
+  }
 }
 
 void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
@@ -309,8 +323,7 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
       e.branchStress = spec_.branch->stress(C, viscousStrain(args.z, q));
       e.stress += e.branchStress;
       e.gammaRate = viscousStrain(args.zdot, q);
-      if (!spec_.thermal)
-        flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
+      addDissipation(q, e, flows);
     }
     // coupling stress at theta_h; the coupling entropy's rate 3 beta K tr(F^-1 dF/dt)
     double couplingShift = 0.0;
@@ -337,13 +350,11 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
         out);
     if (spec_.thermal) assembleHeat(q, e, entropyRateGradient, nodes, out);
   }
-  if (spec_.thermal)
-    for (int a = 0; a < nodes_; ++a) {
-      const int row = firstThermal_ + a;
-      const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
-      out.r[row] += capacity * args.zdot[spec_.thermalDofs[a]];
-      out.tangent()(row, row) += args.beta * capacity;
-    }
+  if (spec_.thermal) {
+    ShapeValues rates = ShapeValues::Zero();
+    for (int a = 0; a < nodes_; ++a) rates[a] = args.zdot[spec_.thermalDofs[a]];
+    addHeatCapacity(rates, args.beta, out);
+  }
 }
 
 Mat3 SolidElement::meanCauchyStress(const double* z) const {

@@ -75,6 +75,10 @@ class SolidElement final : public Component {
   struct NodeTemperatures;
   double pointTemperature(int point, const NodeTemperatures& nodes) const;
   void setFluidity(PointEvaluation& e) const;
+  void addDissipation(int point, const PointEvaluation& e, Flows& flows) const;
+  // The lumped heat capacity's rows m_a kappa rate_a; the rates' derivative in theta_a' (or
+  // theta_a) is rateCoefficient.
+  void addHeatCapacity(const ShapeValues& rates, double rateCoefficient, LocalSystem& out) const;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
   // Mark the evaluation of a state with an inverted cell as inadmissible.

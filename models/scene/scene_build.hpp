@@ -159,8 +159,8 @@ const std::vector<ElementKind>& multibodyElementKinds();
 const std::vector<ElementKind>& solidElementKinds();
 const std::vector<ElementKind>& thermalSolidElementKinds();
 
-// A <solid>'s thermal material (heat_capacity, conductivity, expansion, reference_temperature),
-// or none when it gives no heat_capacity.
+// A <solid>'s thermal material (heat_capacity, conductivity, expansion, reference_temperature,
+// viscosity_activation), or none when it gives no heat_capacity.
 std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
                                                    const LameParameters& lame);
 // Take a thermal solid's nodal temperature dofs (by node) at its initial 'temperature'.

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace mpx {
 
 std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
@@ -54,10 +56,22 @@ const SolidPlacement& thermalSolidOf(ElementReader& in, const SceneBuild& build)
   return solid;
 }
 
+bool hasPrescribedTemperature(const SceneBuild& build, int dof) {
+  return std::any_of(build.prescribedMotions.begin(), build.prescribedMotions.end(),
+                     [&](const PrescribedMotion& p) { return p.dof == dof; });
+}
+
 void buildInitialTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
   const SolidPlacement& solid = thermalSolidOf(in, build);
   const double temperature = in.positive("temperature");
-  for (int node : build.solidNodes(in, solid)) build.state[solid.thermalDofs[node]] = temperature;
+  // a held node starts at its prescribed value; the row only imposes its change
+  for (int node : build.solidNodes(in, solid)) {
+    const int dof = solid.thermalDofs[node];
+    if (hasPrescribedTemperature(build, dof))
+      in.fail(
+          fmt::format("node {} of '{}' has a prescribed temperature, which is also its initial one", node, solid.name));
+    build.state[dof] = temperature;
+  }
 }
 
 // Dirichlet: the nodes' heat rows become theta = temperature * profile(t), and their reactions
@@ -70,8 +84,8 @@ void buildPrescribedTemperature(ElementReader& in, SceneBuild& build, DofRange&)
   if (!(profile(0.0) > 0.0)) in.fail("the prescribed temperature must be positive at t = 0");
   for (int node : nodes) {
     const int dof = solid.thermalDofs[node];
-    for (const PrescribedMotion& p : build.prescribedMotions)
-      if (p.dof == dof) in.fail(fmt::format("node {} of '{}' already has a prescribed temperature", node, solid.name));
+    if (hasPrescribedTemperature(build, dof))
+      in.fail(fmt::format("node {} of '{}' already has a prescribed temperature", node, solid.name));
     build.prescribedMotions.push_back({dof, temperature, profile, PrescribedKind::Temperature});
     build.state[dof] = temperature * profile(0.0);
   }
