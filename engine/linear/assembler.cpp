@@ -79,15 +79,15 @@ void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, con
   for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
 }
 
-void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double rate) {
+void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate) {
   const double reaction = residual_[p.dof];
   // a prescribed temperature's reaction is the heat it supplies, which brings entropy at that
-  // temperature (`rate` holds it); a prescribed velocity's reaction does work
+  // temperature (`conjugate` holds it); a prescribed velocity's reaction does work
   if (p.kind == PrescribedKind::Temperature) {
     flows_.boundaryHeat += reaction;
-    flows_.boundaryEntropy += reaction / rate;
+    flows_.boundaryEntropy += reaction / conjugate;
   } else {
-    flows_.externalWork += reaction * rate;
+    flows_.externalWork += reaction * conjugate;
   }
   double* values = tangent_.valuePtr();
   for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
@@ -102,12 +102,12 @@ void Assembler::imposeStepMotions(const Model& model, const double* zOld, const 
     const double change = p.amplitude * (p.profile(t + dt) - p.profile(t));
     const double meanVelocity = 0.5 * (zOld[p.dof] + zNew[p.dof]);
     // heat through a prescribed temperature enters at the discrete temperature its cells use
-    const double rate =
+    const double conjugate =
         p.kind == PrescribedKind::Temperature ? logarithmicMean(zOld[p.dof], zNew[p.dof]).value : meanVelocity;
     if (p.kind == PrescribedKind::Displacement)
-      replaceRow(k, p, meanVelocity - change / dt, 0.5, meanVelocity);
+      replaceRow(k, p, meanVelocity - change / dt, 0.5, conjugate);
     else
-      replaceRow(k, p, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, rate);
+      replaceRow(k, p, (zNew[p.dof] - zOld[p.dof] - change) / dt, 1.0 / dt, conjugate);
   }
 }
 

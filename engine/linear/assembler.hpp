@@ -92,9 +92,9 @@ class Assembler {
 
  private:
   // Prescribed motion k: its row becomes `value` with `diagonal` as the only tangent entry;
-  // the reaction (the row's residual before) does work at velocity `rate`, or, for a
-  // temperature, is heat that enters at temperature `rate`.
-  void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double rate);
+  // the reaction (the row's residual before) does work at velocity `conjugate`, or, for a
+  // temperature, is heat that enters at temperature `conjugate`.
+  void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate);
   void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);
 
   Eigen::VectorXd residual_;

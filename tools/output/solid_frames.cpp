@@ -59,6 +59,7 @@ void SolidFrames::write(const StepRecord& record) {
       appendSymmetric(sigma, stress.values);
       vonMises.values.push_back(vonMisesOf(sigma));
       appendSymmetric(cell->meanViscousStrain(z), viscous.values);
+      if (!thermal) continue;
       const Vec3 flux = cell->meanHeatFlux(z);
       heatFlux.values.insert(heatFlux.values.end(), {flux.x(), flux.y(), flux.z()});
       cellTemperature.values.push_back(cell->meanTemperature(z));
