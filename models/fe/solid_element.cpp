@@ -304,7 +304,8 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
 }
 
 void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  const NodePositions x = positions(args.z), xRate = positions(args.zdot);
+  // position rates only feed a thermal cell's coupling entropy rate
+  const NodePositions x = positions(args.z), xRate = spec_.thermal ? positions(args.zdot) : NodePositions::Zero();
   NodeTemperatures nodes;
   if (spec_.thermal)
     for (int a = 0; a < nodes_; ++a) {
