@@ -486,6 +486,28 @@ TEST_F(CliTest, ThermalSolidRunWritesTemperaturesAndBoundaryColumns) {
     EXPECT_NE(vtu.find(field), std::string::npos) << "frame lacks " << field;
 }
 
+// In the entropy form the history still reports temperatures, and they are the temperature
+// form's (the two EEM forms solve the same discrete system, docs/theory.md section 9.7)
+TEST_F(CliTest, ThermalSolidReportsTheSameTemperaturesInTheEntropyForm) {
+  const fs::path scene = writeScene(
+      sceneWith("  <solid name=\"block\" mesh=\"box\" size=\"2 1 1\" cells=\"2 1 1\" young=\"1000\" poisson=\"0.3\" "
+                "density=\"10\" heat_capacity=\"10\" conductivity=\"5\" expansion=\"1e-3\" temperature=\"300\"/>\n"
+                "  <convection name=\"c\" solid=\"block\" surface=\"x0\" coefficient=\"20\" ambient=\"350\"/>"));
+  std::vector<double> means;
+  for (const char* form : {"eem-temperature", "eem-entropy"}) {
+    const fs::path out = outDir() / form;
+    const Invocation r = metriplex("run " + quoted(scene) + " --integrator " + form + " --out " + quoted(out));
+    ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+    const std::vector<std::string> lines = splitLines(readFile(out / "history.csv"));
+    const std::vector<std::string> header = splitFields(lines.front());
+    const auto it = std::find(header.begin(), header.end(), "temperature_mean_block");
+    ASSERT_NE(it, header.end());
+    means.push_back(std::stod(splitFields(lines.back())[it - header.begin()]));
+  }
+  EXPECT_GT(means[0], 300.5);
+  EXPECT_NEAR(means[1], means[0], 1e-9 * means[0]);
+}
+
 // --dt and --t-end replace the scene's step and end time
 TEST_F(CliTest, StepAndEndTimeOptionsOverrideTheScene) {
   const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) +

@@ -3,8 +3,9 @@
 // thermal boundaries against central differences, a purely mechanical solid without thermal
 // dofs, the conduction bar against its Fourier series (order 2 in space and time), the
 // isolated thermoelastic L-block (E, L, J exact after the load, S never decreasing, at small
-// and large steps), the L-block with Dirichlet temperatures (energy and entropy balances with
-// boundary heat and entropy at every step), EEM converging to IDA's tight solution, and bad input.
+// and large steps), in the entropy form too and against the temperature form, the viscous
+// production against the isothermal dissipation, the L-block with Dirichlet temperatures (energy and entropy balances
+// with boundary heat and entropy at every step), EEM converging to IDA's tight solution, and bad input.
 #include "support.hpp"
 #include "tangent_check.hpp"
 
@@ -54,16 +55,22 @@ struct ThermalCellCase {
   const char* solid;  // extra attributes of the <solid>
   const char* extra;  // further elements
   Scheme scheme;
-  double perturbation = 3e-2;  // of the moved state, relative to the dofs' magnitudes
+  double perturbation = 3e-2;            // of the moved state, relative to the dofs' magnitudes
+  const char* variable = "temperature";  // what the nodal thermal dofs hold
 };
 
-void PrintTo(const ThermalCellCase& c, std::ostream* out) { *out << c.name << "_" << schemeName(c.scheme); }
+std::string caseName(const ThermalCellCase& c) {
+  return std::string(c.name) + "_" + schemeName(c.scheme) + (c.variable[0] == 'e' ? "_entropy" : "");
+}
+
+void PrintTo(const ThermalCellCase& c, std::ostream* out) { *out << caseName(c); }
 
 std::string thermalCell(const ThermalCellCase& c) {
-  return std::string(R"(<metriplex name="thermal_cell"><simulation dt="0.1" t_end="10"/>
+  return std::string(R"(<metriplex name="thermal_cell"><simulation dt="0.1" t_end="10" thermal_variable=")") +
+         c.variable + R"("/>
     <solid name="cell" young="1000" poisson="0.3" density="10" velocity="0.1 -0.2 0.3"
            angular_velocity="0.5 0.2 -0.4" heat_capacity="100" conductivity="40" expansion="1e-3"
-           reference_temperature="300" temperature="310" )") +
+           reference_temperature="300" temperature="310" )" +
          c.solid + "/>" + c.extra + "</metriplex>";
 }
 
@@ -84,25 +91,29 @@ TEST_P(ThermalCellTangent, MatchesFiniteDifferences) {
 }
 
 std::vector<ThermalCellCase> thermalCellCases() {
-  const char* boundaries =
-      R"(<heat_flux name="q" solid="cell" surface="x1" flux="50" profile="ramp" end="2"/>
-         <convection name="h" solid="cell" surface="z0" coefficient="20" ambient="280"/>
-         <prescribed_temperature solid="cell" surface="x0" temperature="305"/>)";
+  const std::string fluxes = R"(<heat_flux name="q" solid="cell" surface="x1" flux="50" profile="ramp" end="2"/>
+         <convection name="h" solid="cell" surface="z0" coefficient="20" ambient="280"/>)";
+  static const std::string boundaries =
+      fluxes + R"(<prescribed_temperature solid="cell" surface="x0" temperature="305"/>)";
+  static const std::string entropyBoundaries = fluxes;  // the entropy form takes no prescribed temperature
   std::vector<ThermalCellCase> cases;
-  for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal}) {
-    cases.push_back({"hex8", R"(mesh="box" cells="1 1 1")", "", scheme});
-    cases.push_back({"hex8_boundaries", R"(mesh="box" cells="1 1 1")", boundaries, scheme});
-    cases.push_back({"hex8_linked", R"(mesh="box" cells="1 1 1")",
-                     R"(<reservoir name="r" heat_capacity="50" temperature="290"/>
+  for (const char* variable : {"temperature", "entropy"})
+    for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal}) {
+      const bool entropy = variable[0] == 'e';
+      cases.push_back({"hex8", R"(mesh="box" cells="1 1 1")", "", scheme, 3e-2, variable});
+      cases.push_back({"hex8_boundaries", R"(mesh="box" cells="1 1 1")",
+                       entropy ? entropyBoundaries.c_str() : boundaries.c_str(), scheme, 3e-2, variable});
+      cases.push_back({"hex8_linked", R"(mesh="box" cells="1 1 1")",
+                       R"(<reservoir name="r" heat_capacity="50" temperature="290"/>
                         <surface_heat_link name="l" solid="cell" surface="x1" node="r" coefficient="30"/>
                         <fixed_temperature name="w" temperature="320"/>
                         <surface_heat_link name="lw" solid="cell" surface="y0" node="w" coefficient="10"/>)",
-                     scheme});
-    cases.push_back(
-        {"hex8_viscous",
-         R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100" viscosity_activation="0.02")",
-         "", scheme});
-  }
+                       scheme, 3e-2, variable});
+      cases.push_back(
+          {"hex8_viscous",
+           R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100" viscosity_activation="0.02")",
+           "", scheme, 3e-2, variable});
+    }
   // the bar's tetrahedra are 0.5 across in a body 4 long: a smaller perturbation keeps them uninverted
   cases.push_back(
       {"tet4_viscous", R"(mesh="meshes/bar_tets.msh" branch_mu="50" viscosity="100")", "", Scheme::Eem, 5e-3});
@@ -110,9 +121,7 @@ std::vector<ThermalCellCase> thermalCellCases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryCell, ThermalCellTangent, ::testing::ValuesIn(thermalCellCases()),
-                         [](const ::testing::TestParamInfo<ThermalCellCase>& info) {
-                           return std::string(info.param.name) + "_" + schemeName(info.param.scheme);
-                         });
+                         [](const ::testing::TestParamInfo<ThermalCellCase>& info) { return caseName(info.param); });
 
 // ---------------------------------------------------------------------------------------------
 // 2b. On a flat tetrahedron with obtuse dihedral angles, where the plain Galerkin conduction
@@ -123,7 +132,7 @@ TEST(HeatConduction, ProducesEntropyOnAnObtuseTetrahedronWherePlainGalerkinDoesN
   const std::vector<Vec3> nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.33, 0.33, 0.02}};
   const std::vector<CellPoint> points = cellQuadrature(CellType::Tet4, nodes, Integrand::Stiffness);
   const double k0 = 3.0;
-  const HeatConduction conduction("tet", {0, 1, 2, 3}, points, k0);
+  const HeatConduction conduction("tet", {0, 1, 2, 3}, NodalThermalVariable(), points, k0);
   const Eigen::Vector4d theta(300.0, 400.0, 300.0, 330.0), thetaNew = theta;
   std::vector<double> r(4), k(16);
   LocalSystem local{4, r.data(), k.data()};
@@ -255,6 +264,60 @@ TEST(ThermoelasticLBlock, EemKeepsEnergyMomentaAndEntropyAtSmallAndLargeSteps) {
               midpoint.summary.failed ? midpoint.summary.failure.c_str() : "ran to the end");
 }
 
+// 5b. The entropy form (nodal dofs s_a = kappa ln(theta_a/theta_R)) keeps the same balances, and
+// since its discrete temperature is again the logarithmic mean (docs/theory.md section 9.7) it
+// solves the same discrete system as the temperature form: the two agree to Newton's tolerance,
+// far inside the O(dt^2) time error (measured here as the change when dt is halved).
+// The midpoint rule, whose midpoint temperature theta(s_m) differs from theta_m at O(dt^2), does
+// depend on the form: its two solutions approach each other at order 2.
+struct FormSolution {
+  VectorXd positions, temperatures;
+};
+
+FormSolution finalSolution(const CompiledScene& scene, const History& h) {
+  const SolidPlacement& block = scene.solids.front();
+  const Layout& layout = scene.model->layout();
+  FormSolution s{h.states.back().segment(layout.offset(Block::Position), layout.size(Block::Position)),
+                 VectorXd(block.thermalDofs.size())};
+  for (Eigen::Index n = 0; n < s.temperatures.size(); ++n)
+    s.temperatures[n] = block.nodeTemperature(h.states.back().data(), static_cast<int>(n));
+  return s;
+}
+
+double formDifference(const FormSolution& a, const FormSolution& b) {
+  return std::max((a.positions - b.positions).cwiseAbs().maxCoeff() / 10.0,  // block size 10
+                  (a.temperatures - b.temperatures).cwiseAbs().maxCoeff() / 300.0);
+}
+
+TEST(ThermoelasticLBlock, EntropyFormKeepsTheBalancesAndAgreesWithTheTemperatureForm) {
+  const CompiledScene temperature = loadScene(scenePath("lblock_thermoelastic.xml"));
+  const CompiledScene entropy = loadScene(scenePath("lblock_thermoelastic.xml"), ThermalVariable::Entropy);
+  ASSERT_EQ(entropy.model->thermalVariable(), ThermalVariable::Entropy);
+  expectIsolatedBalances(run(*entropy.model, Scheme::Eem, 0.2, 15.0), "entropy form EEM dt 0.2");
+
+  const double tEnd = 3.0;
+  const auto solve = [&](const CompiledScene& scene, Scheme scheme, double dt) {
+    const History h = run(*scene.model, scheme, dt, tEnd);
+    EXPECT_FALSE(h.summary.failed) << h.summary.failure;
+    return finalSolution(scene, h);
+  };
+  const FormSolution coarse = solve(temperature, Scheme::Eem, 0.1), fine = solve(temperature, Scheme::Eem, 0.05);
+  const double timeError = formDifference(coarse, fine);
+  const double eemGap = std::max(formDifference(coarse, solve(entropy, Scheme::Eem, 0.1)),
+                                 formDifference(fine, solve(entropy, Scheme::Eem, 0.05)));
+  std::printf("EEM at t = %.0f: entropy against temperature form %.2e; dt 0.1 against 0.05 %.2e\n", tEnd, eemGap,
+              timeError);
+  EXPECT_LT(eemGap, 1e-6 * timeError);
+
+  std::vector<double> steps, gaps;
+  for (double dt : {0.2, 0.1}) {
+    steps.push_back(dt);
+    gaps.push_back(formDifference(solve(temperature, Scheme::Midpoint, dt), solve(entropy, Scheme::Midpoint, dt)));
+  }
+  std::printf("midpoint: entropy against temperature form %.2e (dt 0.2), %.2e (dt 0.1)\n", gaps[0], gaps[1]);
+  EXPECT_NEAR(logLogSlope(steps, gaps), 2.0, 0.3);
+}
+
 // Thermo-viscoelastic L-block: the branch (temperature-dependent viscosity) heats the block;
 // E, L, J stay exact after the load and S never decreases.
 TEST(ThermoviscoelasticLBlock, EemKeepsEnergyAndMomentaWhileTheBranchHeatsTheBlock) {
@@ -269,6 +332,51 @@ TEST(ThermoviscoelasticLBlock, EemKeepsEnergyAndMomentaWhileTheBranchHeatsTheBlo
   std::printf("entropy produced to t = 6: %.4e with the branch, %.4e without\n", h.entropy.back() - h.entropy.front(),
               e.entropy.back() - e.entropy.front());
   EXPECT_GT(h.entropy.back() - h.entropy.front(), 1.05 * (e.entropy.back() - e.entropy.front()));
+}
+
+// With beta = 0 and a constant viscosity the temperature field is passive: the motion is that of
+// the isothermal viscoelastic solid, whose run reports the energy D_n its branch dissipates in
+// each step. The thermal solid keeps that energy as heat (E exact) and its entropy grows in each
+// step by at least D_n / theta_max (the viscous production; conduction adds a non-negative one).
+TEST(ThermoviscoelasticSolid, ProducesAtLeastTheViscousDissipationOverTheTemperature) {
+  const auto scene = [](const std::string& thermal) {
+    return R"(<metriplex name="viscous_column"><simulation dt="0.05" t_end="2"/>
+      <solid name="column" mesh="box" size="1 4 1" cells="1 4 1" lambda="500" mu="400" density="10" twist="3 8"
+             branch_mu="300" viscosity="4" )" +
+           thermal + "/></metriplex>";
+  };
+  const CompiledScene isothermal = loadSceneText(scene(""), scenePath("viscous_column.xml"));
+  const CompiledScene thermal =
+      loadSceneText(scene(R"(heat_capacity="20" conductivity="3" reference_temperature="300" temperature="300")"),
+                    scenePath("viscous_column.xml"));
+  const History mechanical = run(*isothermal.model, Scheme::Eem, 0.05, 2.0),
+                heated = run(*thermal.model, Scheme::Eem, 0.05, 2.0);
+  ASSERT_FALSE(mechanical.summary.failed || heated.summary.failed);
+  ASSERT_EQ(mechanical.states.size(), heated.states.size());
+  const SolidPlacement& column = thermal.solids.front();
+  const Layout& layout = thermal.model->layout();
+  const auto positions = [&](const History& h, std::size_t n) {
+    return h.states[n].segment(layout.offset(Block::Position), layout.size(Block::Position));
+  };
+  const auto hottest = [&](std::size_t n) {
+    double theta = 0.0;
+    for (std::size_t a = 0; a < column.thermalDofs.size(); ++a)
+      theta = std::max(theta, column.nodeTemperature(heated.states[n].data(), static_cast<int>(a)));
+    return theta;
+  };
+  double worstMargin = INFINITY;
+  for (std::size_t n = 1; n < heated.states.size(); ++n) {
+    EXPECT_LT((positions(heated, n) - positions(mechanical, n)).cwiseAbs().maxCoeff(), 1e-8) << "step " << n;
+    const double dissipated = mechanical.dissipated[n] - mechanical.dissipated[n - 1];
+    const double bound = dissipated / std::max(hottest(n - 1), hottest(n));
+    const double production = heated.entropy[n] - heated.entropy[n - 1];
+    EXPECT_GE(production, bound - 1e-12 * std::abs(heated.entropy[n])) << "step " << n;
+    worstMargin = std::min(worstMargin, production / bound);
+  }
+  std::printf("viscous column: dissipated %.4e J, heated to %.2f K; production / (D / theta_max) >= %.6f\n",
+              mechanical.dissipated.back(), hottest(heated.states.size() - 1), worstMargin);
+  EXPECT_GT(mechanical.dissipated.back(), 1e-3 * std::abs(mechanical.energy.front()));
+  EXPECT_LT(std::abs(heated.energy.back() - heated.energy.front()), 1e-10 * std::abs(heated.energy.front()));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -367,7 +475,9 @@ TEST(ThermalSolidInput, IsRefusedWithFileLineAndReason) {
   expectSceneError(R"(/>
     <convection name="c" solid="s" surface="x0" coefficient="1" ambient="300"/>)",
                    "has no temperature field");
-  expectSceneError(R"(heat_capacity="1"/>)", "temperature-based EEM only", true);
+  expectSceneError(R"(heat_capacity="1"/>
+    <prescribed_temperature solid="s" surface="x0" temperature="300"/>)",
+                   "needs the temperature form", true);
   expectSceneError(R"(heat_capacity="1" viscosity_activation="0.01"/>)", "needs a viscous branch");
   expectSceneError(R"(heat_capacity="1"/>
     <prescribed_temperature solid="s" surface="x0" temperature="300"/>

@@ -1,12 +1,11 @@
 #include "models/fe/heat_conduction.hpp"
 
-#include "engine/core/discrete_gradient.hpp"
-
 namespace mpx {
 
-HeatConduction::HeatConduction(std::string name, std::vector<int> thermalDofs, std::vector<CellPoint> points,
-                               double conductivity)
+HeatConduction::HeatConduction(std::string name, std::vector<int> thermalDofs, NodalThermalVariable thermalVariable,
+                               std::vector<CellPoint> points, double conductivity)
     : Component(std::move(name), std::move(thermalDofs)),
+      thermalVariable_(thermalVariable),
       points_(std::move(points)),
       conductivity_(conductivity),
       nodes_(static_cast<int>(dofs().size())) {}
@@ -39,9 +38,9 @@ void HeatConduction::assemble(const ShapeValues& T, const ShapeValues& slope, Lo
 void HeatConduction::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&) const {
   ShapeValues T = ShapeValues::Zero(), slope = ShapeValues::Zero();
   for (int a = 0; a < nodes_; ++a) {
-    const LogarithmicMean mean = logarithmicMean(args.zOld[dofs()[a]], args.zNew[dofs()[a]]);
-    T[a] = mean.value;
-    slope[a] = mean.derivative;
+    const TemperatureJet jet = thermalVariable_.step(args.zOld[dofs()[a]], args.zNew[dofs()[a]]);
+    T[a] = jet.value;
+    slope[a] = jet.slope;
   }
   assemble(T, slope, out);
 }
@@ -49,8 +48,9 @@ void HeatConduction::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out
 void HeatConduction::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows&) const {
   ShapeValues T = ShapeValues::Zero(), slope = ShapeValues::Zero();
   for (int a = 0; a < nodes_; ++a) {
-    T[a] = args.z[dofs()[a]];
-    slope[a] = args.alpha;
+    const TemperatureJet jet = thermalVariable_.rate(args.z[dofs()[a]], args.alpha);
+    T[a] = jet.value;
+    slope[a] = jet.slope;
   }
   assemble(T, slope, out);
 }

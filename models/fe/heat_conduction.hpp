@@ -7,6 +7,7 @@
 // of theta_a, theta_a' in an EEM step, theta_a in the rate form). Summed over a, the rows give
 // no energy (sum_a T_a Grad(N_a/theta) = Grad(1) = 0); divided by T_a and summed, they give the
 // entropy production sum_q w k0 |Grad theta|^2 / theta^2 >= 0, on any mesh.
+#include "models/fe/nodal_thermal_variable.hpp"
 #include "models/fe/shape_functions.hpp"
 
 #include "engine/core/component.hpp"
@@ -15,17 +16,19 @@ namespace mpx {
 
 class HeatConduction final : public Component {
  public:
-  HeatConduction(std::string name, std::vector<int> thermalDofs, std::vector<CellPoint> points, double conductivity);
+  HeatConduction(std::string name, std::vector<int> thermalDofs, NodalThermalVariable thermalVariable,
+                 std::vector<CellPoint> points, double conductivity);
 
   void measure(const double*, Measures&) const override {}
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
-  // Rows and tangent for nodal temperatures T with derivatives slope (dT_a/dtheta_a times the
-  // tangent's coefficient).
+  // Rows and tangent for nodal temperatures T with derivatives slope (dT_a/ds_a times the
+  // tangent's coefficient, s_a the node's dof).
   void assemble(const ShapeValues& T, const ShapeValues& slope, LocalSystem& out) const;
 
+  NodalThermalVariable thermalVariable_;
   std::vector<CellPoint> points_;
   double conductivity_;
   int nodes_;

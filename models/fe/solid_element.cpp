@@ -81,13 +81,19 @@ void SolidElement::addDissipation(int q, const PointEvaluation& e, Flows& flows)
     flows.dissipated += spec_.points[q].weight * contract(e.branchStress, e.branchStress) / spec_.branch->viscosity;
 }
 
-void SolidElement::addHeatCapacity(const ShapeValues& rates, double rateCoefficient, LocalSystem& out) const {
+void SolidElement::addHeatCapacity(const ShapeValues& energyRates, const ShapeValues& energyRateSlopes,
+                                   LocalSystem& out) const {
   for (int a = 0; a < nodes_; ++a) {
     const int row = firstThermal_ + a;
-    const double capacity = nodeVolume_[a] * spec_.thermal->capacity;
-    out.r[row] += capacity * rates[a];
-    out.tangent()(row, row) += capacity * rateCoefficient;
+    out.r[row] += nodeVolume_[a] * energyRates[a];
+    out.tangent()(row, row) += nodeVolume_[a] * energyRateSlopes[a];
   }
+}
+
+ShapeValues SolidElement::nodeTemperatures(const double* z) const {
+  ShapeValues theta = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) theta[a] = spec_.thermalVariable.temperature(z[spec_.thermalDofs[a]]);
+  return theta;
 }
 
 // eta(theta) = eta_R exp(-a (theta - theta_R)) at the point's temperature (constant without a
@@ -133,11 +139,10 @@ void SolidElement::measure(const double* z, Measures& out) const {
   }
   if (!spec_.thermal) return;
   // the heat capacity, lumped at the nodes
-  const ThermalMaterial& m = *spec_.thermal;
   for (int a = 0; a < nodes_; ++a) {
-    const double theta = z[spec_.thermalDofs[a]];
-    out.energy += nodeVolume_[a] * m.capacity * (theta - m.referenceTemperature);
-    out.entropy += nodeVolume_[a] * m.capacity * std::log(theta / m.referenceTemperature);
+    const double s = z[spec_.thermalDofs[a]];
+    out.energy += nodeVolume_[a] * spec_.thermalVariable.energy(s);
+    out.entropy += nodeVolume_[a] * spec_.thermalVariable.entropy(s);
   }
 }
 
@@ -247,9 +252,9 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
   if (spec_.thermal)
     for (int a = 0; a < nodes_; ++a) {
       const int dof = spec_.thermalDofs[a];
-      const LogarithmicMean mean = logarithmicMean(args.zOld[dof], args.zNew[dof]);
-      nodes.value[a] = mean.value;
-      nodes.slope[a] = mean.derivative;
+      const TemperatureJet T = spec_.thermalVariable.step(args.zOld[dof], args.zNew[dof]);
+      nodes.value[a] = T.value;
+      nodes.slope[a] = T.slope;
     }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const ShapeGradients& G = spec_.points[q].gradients;
@@ -296,10 +301,13 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
   }
   // the heat capacity: m_a kappa (theta_a' - theta_a) = T_a m_a kappa ln(theta_a'/theta_a)
   if (spec_.thermal) {
-    ShapeValues rates = ShapeValues::Zero();
-    for (int a = 0; a < nodes_; ++a)
-      rates[a] = (args.zNew[spec_.thermalDofs[a]] - args.zOld[spec_.thermalDofs[a]]) / args.dt;
-    addHeatCapacity(rates, 1.0 / args.dt, out);
+    ShapeValues rates = ShapeValues::Zero(), slopes = ShapeValues::Zero();
+    for (int a = 0; a < nodes_; ++a) {
+      const double s0 = args.zOld[spec_.thermalDofs[a]], s1 = args.zNew[spec_.thermalDofs[a]];
+      rates[a] = (spec_.thermalVariable.energy(s1) - spec_.thermalVariable.energy(s0)) / args.dt;
+      slopes[a] = spec_.thermalVariable.energySlope(s1) / args.dt;
+    }
+    addHeatCapacity(rates, slopes, out);
   }
 }
 
@@ -309,8 +317,9 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
   NodeTemperatures nodes;
   if (spec_.thermal)
     for (int a = 0; a < nodes_; ++a) {
-      nodes.value[a] = args.z[spec_.thermalDofs[a]];
-      nodes.slope[a] = 1.0;
+      const TemperatureJet T = spec_.thermalVariable.rate(args.z[spec_.thermalDofs[a]], 1.0);
+      nodes.value[a] = T.value;
+      nodes.slope[a] = T.slope;
     }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
@@ -333,7 +342,7 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
       const double modulus = spec_.thermal->couplingModulus();
       const Mat3 inverse = F.inverse(), rate = xRate * spec_.points[q].gradients;
       e.temperature = pointTemperature(q, nodes);
-      e.temperatureSlope = spec_.points[q].values;
+      e.temperatureSlope = spec_.points[q].values.cwiseProduct(nodes.slope);
       e.couplingStress = coupling_->stress(C);
       couplingShift = spec_.thermal->referenceTemperature - e.temperature;
       e.stress += couplingShift * e.couplingStress;
@@ -351,10 +360,16 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
         out);
     if (spec_.thermal) assembleHeat(q, e, entropyRateGradient, nodes, out);
   }
+  // the heat capacity's energy rate e'(s) ds/dt
   if (spec_.thermal) {
-    ShapeValues rates = ShapeValues::Zero();
-    for (int a = 0; a < nodes_; ++a) rates[a] = args.zdot[spec_.thermalDofs[a]];
-    addHeatCapacity(rates, args.beta, out);
+    ShapeValues rates = ShapeValues::Zero(), slopes = ShapeValues::Zero();
+    for (int a = 0; a < nodes_; ++a) {
+      const double s = args.z[spec_.thermalDofs[a]], sRate = args.zdot[spec_.thermalDofs[a]];
+      const NodalThermalVariable& v = spec_.thermalVariable;
+      rates[a] = v.energySlope(s) * sRate;
+      slopes[a] = args.alpha * v.energyCurvature(s) * sRate + args.beta * v.energySlope(s);
+    }
+    addHeatCapacity(rates, slopes, out);
   }
 }
 
@@ -380,8 +395,7 @@ Mat3 SolidElement::meanViscousStrain(const double* z) const {
 Vec3 SolidElement::meanHeatFlux(const double* z) const {
   Vec3 sum = Vec3::Zero();
   if (!spec_.thermal) return sum;
-  ShapeValues theta = ShapeValues::Zero();
-  for (int a = 0; a < nodes_; ++a) theta[a] = z[spec_.thermalDofs[a]];
+  const ShapeValues theta = nodeTemperatures(z);
   for (const CellPoint& p : spec_.points) sum -= spec_.thermal->conductivity * p.gradients.transpose() * theta;
   return sum / static_cast<double>(spec_.points.size());
 }
@@ -389,8 +403,8 @@ Vec3 SolidElement::meanHeatFlux(const double* z) const {
 double SolidElement::meanTemperature(const double* z) const {
   double sum = 0.0;
   if (!spec_.thermal) return sum;
-  for (const CellPoint& p : spec_.points)
-    for (int a = 0; a < nodes_; ++a) sum += p.values[a] * z[spec_.thermalDofs[a]];
+  const ShapeValues theta = nodeTemperatures(z);
+  for (const CellPoint& p : spec_.points) sum += p.values.dot(theta);
   return sum / static_cast<double>(spec_.points.size());
 }
 

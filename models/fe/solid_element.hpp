@@ -12,13 +12,15 @@
 // (xx, yy, zz, xy, yz, xz) per quadrature point, nodal temperatures.
 //
 // A thermoelastic cell (docs/theory.md section 9) adds the coupling stress (theta_R - theta) 3 beta K C^-1 and the
-// nodes' heat-balance rows T_a [sum_q w N_a (eta_q' - eta_q)/dt] + m_a kappa (theta_a' - theta_a)/dt - heating_a,
+// nodes' heat-balance rows T_a [sum_q w N_a (eta_q' - eta_q)/dt] + m_a kappa (theta_a' - theta_a)/dt - heating_a
+// (the thermal dofs hold theta or the capacity's entropy, models/fe/nodal_thermal_variable.hpp),
 // with T_a the nodal discrete temperature (the logarithmic mean of theta_a, theta_a') and theta = sum_a N_a T_a at
 // the points; the heat capacity's entropy is lumped at the nodes (m_a = int N_a dV). Since every cell weighs its
 // contribution to node a's row with the same T_a, the rows are T_a times a nodal entropy balance: summed with weight
 // 1 / T_a they give the entropy change, summed with weight 1 the energy change, both exactly. The branch's
 // dissipation heats the nodes (weights N_a) instead of leaving the system.
 #include "models/fe/material.hpp"
+#include "models/fe/nodal_thermal_variable.hpp"
 #include "models/fe/shape_functions.hpp"
 
 #include "engine/core/component.hpp"
@@ -37,7 +39,8 @@ struct SolidElementSpec {
   std::shared_ptr<const HyperelasticMaterial> material;
   std::optional<ViscousBranch> branch;
   std::optional<ThermalMaterial> thermal;
-  std::vector<int> thermalDofs;  // thermal dof of each node, cell order (thermal cells only)
+  std::vector<int> thermalDofs;          // thermal dof of each node, cell order (thermal cells only)
+  NodalThermalVariable thermalVariable;  // what those dofs hold
 };
 
 class SolidElement final : public Component {
@@ -76,9 +79,11 @@ class SolidElement final : public Component {
   double pointTemperature(int point, const NodeTemperatures& nodes) const;
   void setFluidity(PointEvaluation& e) const;
   void addDissipation(int point, const PointEvaluation& e, Flows& flows) const;
-  // The lumped heat capacity's rows m_a kappa rate_a; the rates' derivative in theta_a' (or
-  // theta_a) is rateCoefficient.
-  void addHeatCapacity(const ShapeValues& rates, double rateCoefficient, LocalSystem& out) const;
+  // The lumped heat capacity's rows m_a (rate of its energy per volume) with the rates' derivatives in
+  // the nodes' dofs.
+  void addHeatCapacity(const ShapeValues& energyRates, const ShapeValues& energyRateSlopes, LocalSystem& out) const;
+  // Temperatures of the nodes in state z.
+  ShapeValues nodeTemperatures(const double* z) const;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
   // Mark the evaluation of a state with an inverted cell as inadmissible.

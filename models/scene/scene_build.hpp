@@ -65,7 +65,10 @@ struct SolidPlacement {
   int firstPositionDof;
   int velocityShift;
   std::vector<const SolidElement*> cells;
-  std::vector<int> thermalDofs;  // each node's temperature dof; empty for a purely mechanical solid
+  std::vector<int> thermalDofs;          // each node's thermal dof; empty for a purely mechanical solid
+  NodalThermalVariable thermalVariable;  // what those dofs hold
+
+  double nodeTemperature(const double* z, int node) const { return thermalVariable.temperature(z[thermalDofs[node]]); }
 };
 
 // A joint as later elements (joint forces) need it.
@@ -161,11 +164,10 @@ const std::vector<ElementKind>& thermalSolidElementKinds();
 
 // A <solid>'s thermal material (heat_capacity, conductivity, expansion, reference_temperature,
 // viscosity_activation), or none when it gives no heat_capacity.
-std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
-                                                   const LameParameters& lame);
-// Take a thermal solid's nodal temperature dofs (by node) at its initial 'temperature'.
-std::vector<int> takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
-                                  std::size_t nodes);
+std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const LameParameters& lame);
+// Give a thermal solid its nodal thermal dofs (the build's thermal variable), at its initial 'temperature'.
+void takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
+                      SolidPlacement& solid);
 
 // The kind registered for `tag`, or nullptr; all tags, for messages.
 const ElementKind* findElementKind(const std::string& tag);

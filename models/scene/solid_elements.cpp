@@ -118,7 +118,7 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     // elastic constants as Young's modulus and Poisson's ratio, or as the Lame constants
     const LameParameters lame = in.has("mu") ? LameParameters{in.nonNegative("lambda", 0.0), in.positive("mu")}
                                              : LameParameters::fromYoung(in.positive("young"), in.number("poisson"));
-    thermal = readThermalMaterial(in, build, lame);
+    thermal = readThermalMaterial(in, lame);
     if (law == "neo_hooke")
       material = std::make_shared<NeoHooke>(lame);
     else if (law == "svk")
@@ -153,14 +153,15 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     high = high.cwiseMax(X);
   }
   build.keepPositionScale((high - low).norm());
-  SolidPlacement placement{name, mesh, first, shift, {}, {}};
-  if (thermal) placement.thermalDofs = takeTemperatures(in, build, dofs, *thermal, mesh->nodes.size());
+  SolidPlacement placement{name, mesh, first, shift, {}, {}, {}};
+  if (thermal) takeTemperatures(in, build, dofs, *thermal, placement);
 
   // one element and one inertia per cell; a node's kinematic rows belong to its first cell
   std::vector<bool> owned(mesh->nodes.size(), false);
   for (std::size_t c = 0; c < mesh->cells.size(); ++c) {
     const Cell& cell = mesh->cells[c];
-    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, -1, {}, material, branch, thermal, {}};
+    SolidElementSpec element{name + ".cell" + std::to_string(c), {}, shift, -1, {}, material, branch, thermal, {},
+                             placement.thermalVariable};
     SolidInertiaSpec inertia{element.name + ".inertia", {}, shift, {}, {}, density, build.spec.gravity};
     for (int a = 0; a < nodeCount(cell.type); ++a) {
       element.positionDofs.push_back(first + 3 * cell.nodes[a]);
@@ -182,7 +183,8 @@ void buildSolid(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     }
     if (thermal && thermal->conductivity > 0.0)
       build.addComponent(std::make_unique<HeatConduction>(element.name + ".conduction", element.thermalDofs,
-                                                          element.points, thermal->conductivity));
+                                                          placement.thermalVariable, element.points,
+                                                          thermal->conductivity));
     auto solidElement = std::make_unique<SolidElement>(std::move(element));
     placement.cells.push_back(solidElement.get());
     build.addComponent(std::move(solidElement));

@@ -11,16 +11,13 @@
 
 namespace mpx {
 
-std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const SceneBuild& build,
-                                                   const LameParameters& lame) {
+std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const LameParameters& lame) {
   if (!in.has("heat_capacity")) {
     for (const char* attribute :
          {"conductivity", "expansion", "reference_temperature", "temperature", "viscosity_activation"})
       if (in.has(attribute)) in.fail(fmt::format("'{}' needs a thermal solid: give heat_capacity too", attribute));
     return std::nullopt;
   }
-  if (build.variable == ThermalVariable::Entropy)
-    in.fail("a thermal solid takes the temperature-based EEM only (the entropy form is not implemented for solids)");
   ThermalMaterial m;
   m.capacity = in.positive("heat_capacity");
   m.conductivity = in.nonNegative("conductivity", 0.0);
@@ -33,18 +30,17 @@ std::optional<ThermalMaterial> readThermalMaterial(ElementReader& in, const Scen
   return m;
 }
 
-std::vector<int> takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
-                                  std::size_t nodes) {
+void takeTemperatures(ElementReader& in, SceneBuild& build, DofRange& dofs, const ThermalMaterial& m,
+                      SolidPlacement& solid) {
   const double temperature = in.positive("temperature", m.referenceTemperature);
-  const int first = dofs.take(Block::Thermal, static_cast<int>(nodes));
-  std::vector<int> thermalDofs;
-  for (std::size_t n = 0; n < nodes; ++n) {
-    const int dof = first + static_cast<int>(n);
-    thermalDofs.push_back(dof);
-    build.state[dof] = temperature;
-    build.scale[dof] = m.referenceTemperature;
+  const int nodes = static_cast<int>(solid.mesh->nodes.size()), first = dofs.take(Block::Thermal, nodes);
+  solid.thermalVariable = NodalThermalVariable(build.variable, m.capacity, m.referenceTemperature);
+  for (int n = 0; n < nodes; ++n) {
+    const int dof = first + n;
+    solid.thermalDofs.push_back(dof);
+    build.state[dof] = solid.thermalVariable.fromTemperature(temperature);
+    build.scale[dof] = solid.thermalVariable.scale();
   }
-  return thermalDofs;
 }
 
 namespace {
@@ -70,7 +66,7 @@ void buildInitialTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
     if (hasPrescribedTemperature(build, dof))
       in.fail(
           fmt::format("node {} of '{}' has a prescribed temperature, which is also its initial one", node, solid.name));
-    build.state[dof] = temperature;
+    build.state[dof] = solid.thermalVariable.fromTemperature(temperature);
   }
 }
 
@@ -78,6 +74,10 @@ void buildInitialTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
 // are the heat that enters there.
 void buildPrescribedTemperature(ElementReader& in, SceneBuild& build, DofRange&) {
   const SolidPlacement& solid = thermalSolidOf(in, build);
+  if (build.variable == ThermalVariable::Entropy)
+    in.fail(
+        "a prescribed temperature needs the temperature form (the entropy form's dofs are entropies: run "
+        "eem-temperature or set thermal_variable=\"temperature\")");
   const std::vector<int> nodes = build.solidNodes(in, solid);
   const double temperature = in.positive("temperature");
   const TimeFunction profile = readProfile(in, build);
@@ -107,6 +107,7 @@ void addSurfaceHeat(ElementReader& in, SceneBuild& build, SurfaceHeatSpec spec) 
   for (const auto& [node, area] : thermalSurfaceAreas(in, solid)) {
     spec.name = name + ".node" + std::to_string(node);
     spec.thermalDof = solid.thermalDofs[node];
+    spec.thermalVariable = solid.thermalVariable;
     spec.area = area;
     build.addComponent(std::make_unique<SurfaceHeat>(spec));
   }
@@ -136,7 +137,7 @@ void buildSurfaceHeatLink(ElementReader& in, SceneBuild& build, DofRange&) {
   const double coefficient = in.positive("coefficient");
   for (const auto& [node, area] : thermalSurfaceAreas(in, solid))
     build.addComponent(std::make_unique<SurfaceHeatLink>(name + ".node" + std::to_string(node), solid.thermalDofs[node],
-                                                         lumped, coefficient * area));
+                                                         solid.thermalVariable, lumped, coefficient * area));
 }
 
 }  // namespace

@@ -1,7 +1,5 @@
 #include "models/thermal/surface_heat.hpp"
 
-#include "engine/core/discrete_gradient.hpp"
-
 namespace mpx {
 
 SurfaceHeat::SurfaceHeat(SurfaceHeatSpec spec) : Component(spec.name, {spec.thermalDof}), spec_(std::move(spec)) {}
@@ -17,12 +15,13 @@ void SurfaceHeat::exchange(double T, double slope, double q, LocalSystem& out, F
 
 // the flux at the step's midpoint time, which the residual stands for
 void SurfaceHeat::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  const LogarithmicMean mean = logarithmicMean(args.zOld[spec_.thermalDof], args.zNew[spec_.thermalDof]);
-  exchange(mean.value, mean.derivative, spec_.flux * spec_.profile(args.t + 0.5 * args.dt), out, flows);
+  const TemperatureJet T = spec_.thermalVariable.step(args.zOld[spec_.thermalDof], args.zNew[spec_.thermalDof]);
+  exchange(T.value, T.slope, spec_.flux * spec_.profile(args.t + 0.5 * args.dt), out, flows);
 }
 
 void SurfaceHeat::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  exchange(args.z[spec_.thermalDof], args.alpha, spec_.flux * spec_.profile(args.t), out, flows);
+  const TemperatureJet T = spec_.thermalVariable.rate(args.z[spec_.thermalDof], args.alpha);
+  exchange(T.value, T.slope, spec_.flux * spec_.profile(args.t), out, flows);
 }
 
 }  // namespace mpx

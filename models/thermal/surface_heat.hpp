@@ -5,6 +5,8 @@
 // weighted with (the logarithmic mean of theta, theta' in an EEM step), so the heat enters the
 // energy balance exactly; the flux brings entropy q A / T, the convection h A (theta_ambient - T)
 // / theta_ambient, and the rest, h A (theta_ambient - T)^2 / (T theta_ambient) >= 0, is produced.
+#include "models/fe/nodal_thermal_variable.hpp"
+
 #include "engine/core/component.hpp"
 #include "engine/core/time_function.hpp"
 
@@ -13,8 +15,9 @@ namespace mpx {
 struct SurfaceHeatSpec {
   std::string name;
   int thermalDof = -1;
-  double area = 0.0;  // int N_a dA
-  double flux = 0.0;  // amplitude of the prescribed flux (W/m^2), times profile(t)
+  NodalThermalVariable thermalVariable;  // what the dof holds
+  double area = 0.0;                     // int N_a dA
+  double flux = 0.0;                     // amplitude of the prescribed flux (W/m^2), times profile(t)
   TimeFunction profile = TimeFunction::constant(1.0);
   double convection = 0.0;  // h (W/(m^2 K))
   double ambientTemperature = 1.0;
@@ -29,7 +32,7 @@ class SurfaceHeat final : public Component {
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
-  // Row -heat at node temperature T (dT/dtheta times the tangent's coefficient: slope) and flux
+  // Row -heat at node temperature T (dT/ds times the tangent's coefficient: slope) and flux
   // density q; the heat and its entropy cross the boundary.
   void exchange(double T, double slope, double q, LocalSystem& out, Flows& flows) const;
   SurfaceHeatSpec spec_;

@@ -1,7 +1,5 @@
 #include "models/thermal/surface_heat_link.hpp"
 
-#include "engine/core/discrete_gradient.hpp"
-
 #include <algorithm>
 
 namespace mpx {
@@ -13,8 +11,10 @@ std::vector<int> SurfaceHeatLink::collectDofs(int solidThermalDof, const Thermal
   return dofs;
 }
 
-SurfaceHeatLink::SurfaceHeatLink(std::string name, int solidThermalDof, ThermalNodeRef node, double conductance)
+SurfaceHeatLink::SurfaceHeatLink(std::string name, int solidThermalDof, NodalThermalVariable thermalVariable,
+                                 ThermalNodeRef node, double conductance)
     : Component(std::move(name), collectDofs(solidThermalDof, node)),
+      thermalVariable_(thermalVariable),
       node_(std::move(node)),
       conductance_(conductance) {
   if (node_.thermalDof >= 0)
@@ -40,12 +40,13 @@ void SurfaceHeatLink::exchange(double T, double slope, const Workspace& ws, Loca
 }
 
 void SurfaceHeatLink::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
-  const LogarithmicMean mean = logarithmicMean(args.zOld[dofs()[0]], args.zNew[dofs()[0]]);
-  exchange(mean.value, mean.derivative, ws, out, flows);
+  const TemperatureJet T = thermalVariable_.step(args.zOld[dofs()[0]], args.zNew[dofs()[0]]);
+  exchange(T.value, T.slope, ws, out, flows);
 }
 
 void SurfaceHeatLink::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
-  exchange(args.z[dofs()[0]], args.alpha, ws, out, flows);
+  const TemperatureJet T = thermalVariable_.rate(args.z[dofs()[0]], args.alpha);
+  exchange(T.value, T.slope, ws, out, flows);
 }
 
 }  // namespace mpx

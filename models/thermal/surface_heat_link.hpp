@@ -6,13 +6,15 @@
 // one row enters the other exactly, and the entropy production
 // h A (theta_node - T)^2 / (T theta_node) is non-negative. Through a fixed temperature the heat
 // (and its entropy Q / theta_node) crosses the system boundary.
+#include "models/fe/nodal_thermal_variable.hpp"
 #include "models/thermal/heat_link.hpp"
 
 namespace mpx {
 
 class SurfaceHeatLink final : public Component {
  public:
-  SurfaceHeatLink(std::string name, int solidThermalDof, ThermalNodeRef node, double conductance);
+  SurfaceHeatLink(std::string name, int solidThermalDof, NodalThermalVariable thermalVariable, ThermalNodeRef node,
+                  double conductance);
 
   bool isCoupling() const override { return true; }
   // writes the solid node's row and the lumped node's row only
@@ -22,10 +24,11 @@ class SurfaceHeatLink final : public Component {
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
-  // Rows for the solid node at temperature T (slope: dT/dtheta times the tangent's coefficient).
+  // Rows for the solid node at temperature T (slope: dT/ds times the tangent's coefficient).
   void exchange(double T, double slope, const Workspace& ws, LocalSystem& out, Flows& flows) const;
   static std::vector<int> collectDofs(int solidThermalDof, const ThermalNodeRef& node);
 
+  NodalThermalVariable thermalVariable_;  // what the solid node's dof holds
   ThermalNodeRef node_;
   int lumpedRow_ = -1;  // local row of the lumped node's thermal dof, -1 for a fixed temperature
   double conductance_;  // h A

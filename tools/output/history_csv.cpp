@@ -17,7 +17,7 @@ HistoryCsv::HistoryCsv(const std::filesystem::path& directory, const CompiledSce
   for (const std::string& node : scene.model->thermalNodeNames()) header += ",temperature_" + node;
   for (const SolidPlacement& solid : scene.solids) {
     if (solid.thermalDofs.empty()) continue;
-    temperatureFields_.push_back(solid.thermalDofs);
+    thermalSolids_.push_back(&solid);
     for (const char* statistic : {"min", "max", "mean"})
       header += fmt::format(",temperature_{}_{}", statistic, solid.name);
   }
@@ -41,15 +41,16 @@ void HistoryCsv::write(const StepRecord& r) {
       m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
       r.newtonIterations, r.cutbacks, m.constraintViolation);
   for (double temperature : m.nodeTemperature) fmt::print(file_, ",{:.17g}", temperature);
-  for (const std::vector<int>& dofs : temperatureFields_) {
+  for (const SolidPlacement* solid : thermalSolids_) {
     double low = INFINITY, high = -INFINITY, sum = 0.0;
-    for (int dof : dofs) {
-      const double theta = (*r.state)[dof];
+    const int nodes = static_cast<int>(solid->thermalDofs.size());
+    for (int n = 0; n < nodes; ++n) {
+      const double theta = solid->nodeTemperature(r.state->data(), n);
       low = std::min(low, theta);
       high = std::max(high, theta);
       sum += theta;
     }
-    fmt::print(file_, ",{:.17g},{:.17g},{:.17g}", low, high, sum / static_cast<double>(dofs.size()));
+    fmt::print(file_, ",{:.17g},{:.17g},{:.17g}", low, high, sum / nodes);
   }
   std::fputc('\n', file_);
 }

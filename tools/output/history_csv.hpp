@@ -15,6 +15,7 @@ namespace mpx {
 
 class HistoryCsv {
  public:
+  // `scene` must outlive the writer.
   HistoryCsv(const std::filesystem::path& directory, const CompiledScene& scene);
   ~HistoryCsv();
   HistoryCsv(const HistoryCsv&) = delete;
@@ -26,7 +27,7 @@ class HistoryCsv {
   std::filesystem::path path() const { return finalPath_; }
 
  private:
-  std::vector<std::vector<int>> temperatureFields_;  // thermal dofs of each thermal solid
+  std::vector<const SolidPlacement*> thermalSolids_;
   double initialEntropy_ = 0.0;
   bool first_ = true;
   std::FILE* file_ = nullptr;

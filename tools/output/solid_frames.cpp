@@ -49,7 +49,8 @@ void SolidFrames::write(const StepRecord& record) {
     const bool thermal = !solid.thermalDofs.empty();
     if (thermal) {
       VtkField temperature{"temperature", 1, {}};
-      for (int dof : solid.thermalDofs) temperature.values.push_back(z[dof]);
+      for (std::size_t n = 0; n < solid.thermalDofs.size(); ++n)
+        temperature.values.push_back(solid.nodeTemperature(z, static_cast<int>(n)));
       nodeFields.push_back(std::move(temperature));
     }
     VtkField stress{"cauchy_stress", 6, {}}, vonMises{"von_mises", 1, {}}, viscous{"viscous_strain", 6, {}};

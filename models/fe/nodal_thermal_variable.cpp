@@ -1,0 +1,54 @@
+#include "models/fe/nodal_thermal_variable.hpp"
+
+#include "engine/core/discrete_gradient.hpp"
+
+#include <cmath>
+
+namespace mpx {
+
+NodalThermalVariable::NodalThermalVariable(ThermalVariable kind, double capacity, double referenceTemperature)
+    : kind_(kind), capacity_(capacity), referenceTemperature_(referenceTemperature) {}
+
+double NodalThermalVariable::temperature(double s) const {
+  return kind_ == ThermalVariable::Temperature ? s : referenceTemperature_ * std::exp(s / capacity_);
+}
+
+double NodalThermalVariable::fromTemperature(double theta) const {
+  return kind_ == ThermalVariable::Temperature ? theta : capacity_ * std::log(theta / referenceTemperature_);
+}
+
+// expm1 and log keep the small departures from theta_R free of cancellation
+double NodalThermalVariable::energy(double s) const {
+  if (kind_ == ThermalVariable::Temperature) return capacity_ * (s - referenceTemperature_);
+  return capacity_ * referenceTemperature_ * std::expm1(s / capacity_);
+}
+
+double NodalThermalVariable::entropy(double s) const {
+  return kind_ == ThermalVariable::Temperature ? capacity_ * std::log(s / referenceTemperature_) : s;
+}
+
+double NodalThermalVariable::energySlope(double s) const {
+  return kind_ == ThermalVariable::Temperature ? capacity_ : temperature(s);
+}
+
+double NodalThermalVariable::energyCurvature(double s) const {
+  return kind_ == ThermalVariable::Temperature ? 0.0 : temperature(s) / capacity_;
+}
+
+TemperatureJet NodalThermalVariable::step(double sOld, double sNew) const {
+  const double thetaNew = temperature(sNew);
+  const LogarithmicMean mean = logarithmicMean(temperature(sOld), thetaNew);
+  const double chain = kind_ == ThermalVariable::Temperature ? 1.0 : thetaNew / capacity_;
+  return {mean.value, mean.derivative * chain};
+}
+
+TemperatureJet NodalThermalVariable::rate(double s, double alpha) const {
+  const double theta = temperature(s);
+  return {theta, alpha * (kind_ == ThermalVariable::Temperature ? 1.0 : theta / capacity_)};
+}
+
+double NodalThermalVariable::scale() const {
+  return kind_ == ThermalVariable::Temperature ? referenceTemperature_ : capacity_;
+}
+
+}  // namespace mpx
