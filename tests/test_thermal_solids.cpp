@@ -48,6 +48,18 @@ TEST(LogarithmicMean, IsDirectionalAndContinuousAcrossTheSeriesSwitch) {
   }
 }
 
+// Second-order consistency: the discrete temperature of a step departs from the midpoint
+// temperature by -(b - a)^2 / (12 a) + ..., so halving the jump divides the gap by 4, on either
+// side of the series switch.
+TEST(LogarithmicMean, IsASecondOrderApproximationOfTheMidpointTemperature) {
+  const double a = 300.0;
+  for (double u : {0.2, 0.02, 4e-3, 5e-4}) {
+    const auto gap = [&](double jump) { return logarithmicMean(a, a * (1 + jump)).value - a * (1 + 0.5 * jump); };
+    EXPECT_NEAR(gap(u) / gap(0.5 * u), 4.0, 0.1 + u) << u;
+    EXPECT_NEAR(gap(u), -a * u * u / 12.0, 0.3 * a * u * u * (u + 1e-3)) << u;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 2. Tangents of thermal cells, with flux and convection on a face, and a Dirichlet face.
 struct ThermalCellCase {
