@@ -141,8 +141,9 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
   fmt::print("  linear system            {}\n", s.linearSystem);
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
   fmt::print(
-      "  max rel. energy drift    {:.3e}  (|E + dissipated - external work - boundary heat - E0| / largest energy)\n",
-      s.maxEnergyBalanceError);
+      "  max rel. energy drift    {:.3e}  (max |E + dissipated - external work - boundary heat - E0| / largest energy "
+      "of the run; {:.3e} J)\n",
+      s.maxEnergyBalanceError, s.maxAbsoluteEnergyBalanceError);
   fmt::print("  min entropy production   {:.3e}  (per step: S change minus entropy brought in)\n",
              s.minEntropyProduction);
   fmt::print("  history                  {}\n", r.history.string());

@@ -32,9 +32,9 @@ void RunReporter::report(int step, double time, double dt, const Flows& crossed,
   sink_(record_);
 
   // conservation figures: the energy balance against t = 0, the smallest entropy production of a step
-  summary_.maxEnergyBalanceError = std::max(
-      summary_.maxEnergyBalanceError,
-      balance_.relativeError(measures_.energy, crossed.dissipated, crossed.externalWork, crossed.boundaryHeat));
+  summary_.maxEnergyBalanceError =
+      balance_.relativeError(measures_.energy, crossed.dissipated, crossed.externalWork, crossed.boundaryHeat);
+  summary_.maxAbsoluteEnergyBalanceError = balance_.largestError();
   const double produced = measures_.entropy - crossed.boundaryEntropy - previousEntropy_;
   summary_.minEntropyProduction = step == 1 ? produced : std::min(summary_.minEntropyProduction, produced);
   previousEntropy_ = measures_.entropy - crossed.boundaryEntropy;

@@ -44,7 +44,8 @@ struct IdaStatistics {
 
 // The energy balance E + D - W - Q - E_0 of a run: the largest |balance| so far relative to the
 // largest of |E_0|, |E|, D, |W| and |Q| so far, so that a scene started from rest (E_0 = 0)
-// is judged against the energy its loads put in, not against its first tiny step.
+// is judged against the energy its loads put in, not against its first tiny step. At the end
+// of a run both maxima are the whole run's.
 class EnergyBalance {
  public:
   explicit EnergyBalance(double initialEnergy) : initial_(initialEnergy), scale_(std::abs(initialEnergy)) {}
@@ -53,6 +54,7 @@ class EnergyBalance {
     largestError_ = std::max(largestError_, std::abs(energy + dissipated - externalWork - boundaryHeat - initial_));
     return scale_ > 0.0 ? largestError_ / scale_ : largestError_;
   }
+  double largestError() const { return largestError_; }
 
  private:
   double initial_, scale_, largestError_ = 0.0;
@@ -70,10 +72,11 @@ struct RunSummary {
   int cutbacks = 0;
   int rejectedSteps = 0;  // by the error test of adaptive steps
   double wallSeconds = 0.0;
-  // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy seen (EnergyBalance):
+  // max_n |E_n + D_n - W_n - Q_n - E_0| relative to the largest energy of the run (EnergyBalance):
   // energy drift net of dissipated energy D, external work W and boundary heat Q (the plain
-  // energy drift for an isolated system)
+  // energy drift for an isolated system); and the same maximum in joules
   double maxEnergyBalanceError = 0.0;
+  double maxAbsoluteEnergyBalanceError = 0.0;
   double minEntropyProduction = 0.0;  // min_n of S_n - S_{n-1} minus the entropy brought in
   std::optional<IdaStatistics> ida;   // set for IDA runs
   std::string linearSystem;           // what each Newton iteration factorises (one-step schemes)
