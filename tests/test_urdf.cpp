@@ -309,6 +309,11 @@ std::ostream& operator<<(std::ostream& os, const BadUrdf& c) { return os << c.la
 
 const std::vector<BadUrdf> kBadUrdfs = {
     {"MalformedXml", "<robot name=\"bad\">\n  <link name=\"world\">\n</robot>\n", 2, {"malformed XML", "link"}},
+    {"UndeclaredEntity", "<robot name=\"bad\">\n  <link name=\"w&x;\"/>\n</robot>\n", 2, {"undefined entity", "&x;"}},
+    {"SecondRoot",
+     "<robot name=\"a\">\n  <link name=\"world\"/>\n</robot>\n<robot name=\"b\"/>\n",
+     4,
+     {"second root element", "<robot>"}},
     {"RevoluteWithoutLimits",
      robotWith({kWorld, kArm, jointWith("hinge", "revolute", "world", "arm")}),
      0,

@@ -2,6 +2,8 @@
 
 #include "engine/core/input_error.hpp"
 
+#include "models/scene/strict_xml.hpp"
+
 #include <tinyxml2.h>
 
 #include <console_bridge/console.h>
@@ -81,11 +83,8 @@ class UrdfFile {
     text << file.rdbuf();
     text_ = text.str();
     tinyxml2::XMLDocument document;
-    document.Parse(text_.c_str(), text_.size());
-    if (document.Error())
-      throw InputError(path_, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
-    const tinyxml2::XMLElement* robot = document.RootElement();
-    for (const tinyxml2::XMLElement* e = robot ? robot->FirstChildElement() : nullptr; e; e = e->NextSiblingElement())
+    const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_);
+    for (const tinyxml2::XMLElement* e = robot.FirstChildElement(); e; e = e->NextSiblingElement())
       if (const char* name = e->Attribute("name")) lines_.emplace(key(e->Name(), name), e->GetLineNum());
   }
 

@@ -4,6 +4,8 @@
 #include "models/scene/element_reader.hpp"
 #include "models/scene/urdf_import.hpp"
 
+#include "models/scene/strict_xml.hpp"
+
 #include <tinyxml2.h>
 
 #include <filesystem>
@@ -172,12 +174,7 @@ class XmlSceneReader {
 
 SceneSpec readXmlScene(const std::string& text, const std::string& label) {
   tinyxml2::XMLDocument document;
-  document.Parse(text.c_str(), text.size());
-  if (document.Error())
-    throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
-  const XMLElement* root = document.RootElement();
-  if (!root) throw InputError(label, 1, "the file holds no XML element");
-  return XmlSceneReader(*root, label).read();
+  return XmlSceneReader(parseStrictXml(document, text, label), label).read();
 }
 
 }  // namespace mpx

@@ -1,0 +1,136 @@
+#include "models/scene/strict_xml.hpp"
+
+#include "engine/core/input_error.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <vector>
+
+namespace mpx {
+
+namespace {
+
+// A scan of the raw text for what the parser would accept silently; it tracks lines and whether
+// it is in character data, inside a tag or inside a quoted attribute value.
+class XmlTextCheck {
+ public:
+  XmlTextCheck(const std::string& text, const std::string& label) : text_(text), label_(label) {}
+
+  void run() {
+    enum class State { Text, Tag, Value } state = State::Text;
+    char quote = 0;
+    for (; i_ < text_.size(); ++i_) {
+      const char c = text_[i_];
+      if (c == '\n') ++line_;
+      if (state == State::Text) {
+        if (startsWith("<!--")) {
+          skipPast("-->");
+        } else if (startsWith("<![CDATA[")) {
+          skipPast("]]>");
+        } else if (startsWith("<?")) {
+          skipPast("?>");
+        } else if (startsWith("<!")) {
+          fail("document type declarations are not supported (their entities would not be expanded)");
+        } else if (c == '<') {
+          state = State::Tag;
+        } else if (c == '&') {
+          checkReference();
+        }
+      } else if (state == State::Tag) {
+        if (c == '"' || c == '\'') state = State::Value, quote = c;
+        if (c == '>') state = State::Text;
+      } else if (c == quote) {
+        state = State::Tag;
+      } else if (c == '<') {
+        fail("'<' inside an attribute value (write &lt;)");
+      } else if (c == '&') {
+        checkReference();
+      }
+    }
+  }
+
+ private:
+  bool startsWith(const char* prefix) const {
+    return text_.compare(i_, std::char_traits<char>::length(prefix), prefix) == 0;
+  }
+
+  // Leave i_ on the last character of `terminator` (or at the end: tinyxml2 reports the
+  // unterminated construct), counting the lines passed.
+  void skipPast(const char* terminator) {
+    const std::size_t end = text_.find(terminator, i_ + 1);
+    const std::size_t stop =
+        end == std::string::npos ? text_.size() : end + std::char_traits<char>::length(terminator) - 1;
+    for (std::size_t k = i_ + 1; k < stop && k < text_.size(); ++k)
+      if (text_[k] == '\n') ++line_;
+    i_ = stop;
+  }
+
+  // The reference starting at i_: a predefined entity or a character reference to a valid XML
+  // character (#x9, #xA, #xD, #x20-#xD7FF, #xE000-#xFFFD, #x10000-#x10FFFF).
+  void checkReference() {
+    const std::size_t end = text_.find(';', i_);
+    if (end == std::string::npos || end - i_ > 12) fail("'&' that starts no reference (write &amp;)");
+    const std::string name = text_.substr(i_ + 1, end - i_ - 1);
+    for (const char* entity : {"lt", "gt", "amp", "apos", "quot"})
+      if (name == entity) return;
+    if (name.size() < 2 || name[0] != '#')
+      fail("undefined entity '&" + name + ";' (XML predefines only lt, gt, amp, apos, quot)");
+    const bool hex = name[1] == 'x';
+    const std::string digits = name.substr(hex ? 2 : 1);
+    char* stop = nullptr;
+    const unsigned long code = digits.empty() ? 0 : std::strtoul(digits.c_str(), &stop, hex ? 16 : 10);
+    const bool parsed = !digits.empty() && *stop == '\0' && digits.find_first_of("+- ") == std::string::npos;
+    const bool valid = code == 0x9 || code == 0xA || code == 0xD || (code >= 0x20 && code <= 0xD7FF) ||
+                       (code >= 0xE000 && code <= 0xFFFD) || (code >= 0x10000 && code <= 0x10FFFF);
+    if (!parsed || !valid) fail("invalid character reference '&" + name + ";'");
+  }
+
+  [[noreturn]] void fail(const std::string& message) const { throw InputError(label_, line_, message); }
+
+  const std::string& text_;
+  const std::string& label_;
+  std::size_t i_ = 0;
+  int line_ = 1;
+};
+
+// Text outside attribute values carries no meaning in a scene or a URDF: reject it rather than
+// ignore it (an iterative walk: the element nesting is the file's, however deep).
+void rejectText(const tinyxml2::XMLElement& root, const std::string& label) {
+  std::vector<const tinyxml2::XMLNode*> pending = {&root};
+  while (!pending.empty()) {
+    const tinyxml2::XMLNode* node = pending.back();
+    pending.pop_back();
+    for (const tinyxml2::XMLNode* child = node->FirstChild(); child; child = child->NextSibling()) {
+      if (const tinyxml2::XMLText* text = child->ToText()) {
+        const std::string value = text->Value();
+        const std::size_t first = value.find_first_not_of(" \t\r\n");
+        if (first == std::string::npos) continue;
+        const std::size_t last = value.find_last_not_of(" \t\r\n");
+        throw InputError(label, text->GetLineNum(),
+                         "unexpected text '" + value.substr(first, std::min<std::size_t>(last + 1 - first, 32)) +
+                             "' inside <" + node->Value() + ">");
+      } else if (child->ToElement()) {
+        pending.push_back(child);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+const tinyxml2::XMLElement& parseStrictXml(tinyxml2::XMLDocument& document, const std::string& text,
+                                           const std::string& label) {
+  XmlTextCheck(text, label).run();
+  document.Parse(text.c_str(), text.size());
+  if (document.Error())
+    throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
+  const tinyxml2::XMLElement* root = document.RootElement();
+  if (!root) throw InputError(label, 1, "the file holds no XML element");
+  if (const tinyxml2::XMLElement* second = root->NextSiblingElement())
+    throw InputError(label, second->GetLineNum(),
+                     std::string("a second root element <") + second->Name() + "> after <" + root->Name() + ">");
+  rejectText(*root, label);
+  return *root;
+}
+
+}  // namespace mpx
