@@ -112,7 +112,8 @@ class XmlSceneReader {
     scene_.line = rootSpec.where.line;
     scene_.name = root.text("name", "scene");
     root.finish();
-    bool haveSimulation = false;
+    // each settings element at most once (a second would silently override the first)
+    std::map<std::string, int> settingsLines;
     for (const XMLElement* e = root_.FirstChildElement(); e; e = e->NextSiblingElement()) {
       const ElementSpec spec = toSpec(*e, scene_.label, static_cast<int>(scene_.elements.size()) + 1);
       ElementReader in(spec);
@@ -121,9 +122,12 @@ class XmlSceneReader {
         continue;
       }
       if (e->FirstChildElement()) in.fail("<" + spec.tag + "> takes no child elements");
+      const bool settings =
+          spec.tag == "simulation" || spec.tag == "solver" || spec.tag == "gravity" || spec.tag == "constraints";
+      if (settings && !settingsLines.emplace(spec.tag, spec.where.line).second)
+        in.fail("a scene has at most one <" + spec.tag + "> element; the first is on line " +
+                std::to_string(settingsLines[spec.tag]));
       if (spec.tag == "simulation") {
-        if (haveSimulation) in.fail("a scene has one <simulation> element; this is the second");
-        haveSimulation = true;
         readSimulation(in, scene_.settings);
       } else if (spec.tag == "solver") {
         readSolver(in, scene_.settings.newton);
@@ -137,7 +141,7 @@ class XmlSceneReader {
       }
       in.finish();
     }
-    if (!haveSimulation)
+    if (!settingsLines.count("simulation"))
       throw InputError(scene_.label, root_.GetLineNum(), "<metriplex>: missing <simulation dt=... t_end=...> element");
     return std::move(scene_);
   }
