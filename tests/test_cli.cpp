@@ -391,8 +391,8 @@ const std::vector<BadOptions> kBadOptions = {
 };
 
 // A face pushed through the opposite one would turn the cell inside out, where C = F^T F and
-// the energy still look regular: the run stops there as a solver failure (it used to finish
-// with exit 0 in the mirrored configuration)
+// the energy still look regular: the run stops there as a solver failure naming the cell (it
+// used to finish with exit 0 in the mirrored configuration)
 TEST_F(CliTest, InvertingACellIsASolverFailure) {
   const Invocation r = metriplex(
       "run " +
@@ -403,6 +403,8 @@ TEST_F(CliTest, InvertingACellIsASolverFailure) {
       " --out " + quoted(outDir()));
   EXPECT_EQ(r.exitCode, kExitSolverFailure) << r.err;
   EXPECT_NE(r.err.find("solver failure at step 5 (t = 0.5)"), std::string::npos) << r.err;
+  // the failure names the cell whose residual went non-finite and the dof
+  EXPECT_NE(r.err.find("the residual of bar.cell0 at dof 0 (position) was not finite"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(outDir() / "history.csv"));
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace mpx {
@@ -75,7 +76,11 @@ void Assembler::clear() {
 void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight) {
   assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
   double* values = tangent_.valuePtr();
-  for (int i = 0; i < local.n; ++i) residual_[dofs[i]] += weight * local.r[i];
+  for (int i = 0; i < local.n; ++i) {
+    residual_[dofs[i]] += weight * local.r[i];
+    if (!std::isfinite(local.r[i]) && firstNonFinite_.component < 0)
+      firstNonFinite_ = {static_cast<int>(component), dofs[i]};
+  }
   for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
 }
 
@@ -124,6 +129,15 @@ void Assembler::updateRowScale(const Eigen::VectorXd& stateScale) {
   for (int col = 0; col < tangent_.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(tangent_, col); it; ++it)
       rowScale_[it.row()] += std::abs(it.value()) * stateScale[col];
+}
+
+int Assembler::describeNonFinite(const Model& model, char* out, std::size_t size) const {
+  if (firstNonFinite_.component < 0 || size == 0) return 0;
+  const std::string_view block = blockName(model.layout().blockOf(firstNonFinite_.dof));
+  const int written = std::snprintf(out, size, "the residual of %s at dof %d (%.*s) was not finite",
+                                    model.components()[firstNonFinite_.component]->name().c_str(), firstNonFinite_.dof,
+                                    static_cast<int>(block.size()), block.data());
+  return written < 0 ? 0 : std::min(written, static_cast<int>(size) - 1);
 }
 
 double Assembler::relativeResidualNorm() const {

@@ -89,6 +89,18 @@ class Assembler {
   void updateRowScale(const Eigen::VectorXd& stateScale);
   // max_i |R_i| / rowScale_i with the last row scales; infinite if R is not finite.
   double relativeResidualNorm() const;
+  // The first component whose local residual was not finite in an evaluation since
+  // forgetNonFinite(), and the state dof of that entry (both -1 if none): what a failure names.
+  struct NonFiniteEntry {
+    int component = -1;
+    int dof = -1;
+  };
+  const NonFiniteEntry& firstNonFinite() const { return firstNonFinite_; }
+  void forgetNonFinite() { firstNonFinite_ = {}; }
+  // Write "the residual of <component> at dof <k> (<block>) was not finite" into `out` (without
+  // allocating: the failure path of a step that a cut-back may still recover); returns the
+  // characters written, 0 if no entry was seen.
+  int describeNonFinite(const Model& model, char* out, std::size_t size) const;
 
  private:
   // Prescribed motion k: its row becomes `value` with `diagonal` as the only tangent entry;
@@ -97,6 +109,7 @@ class Assembler {
   void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate);
   void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);
 
+  NonFiniteEntry firstNonFinite_;
   Eigen::VectorXd residual_;
   Eigen::VectorXd rowScale_;
   Eigen::SparseMatrix<double> tangent_;

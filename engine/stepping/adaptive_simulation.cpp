@@ -145,7 +145,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   Eigen::VectorXd next(n), half(n), fullStep(n);
   Flows crossed;
   int accepted = 0;
-  char newtonFailure[200] = "";
+  char newtonFailure[sizeof StepOutcome::failure] = "";
   // one step of the scheme, counted in the summary
   auto attempt = [&](const Eigen::VectorXd& from, double t, double dt, Eigen::VectorXd& to, StepOutcome& outcome) {
     outcome = integrator.advance(from, t, dt, to);

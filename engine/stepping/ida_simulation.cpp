@@ -261,7 +261,13 @@ bool IdaProblem::initialise(double firstOutput) {
 
 bool IdaProblem::advanceTo(double tout) {
   realtype reached = 0.0;
-  return IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0 && IDAGetQuad(ida_, &reached, crossed_) >= 0;
+  assembler_.forgetNonFinite();
+  if (IDASolve(ida_, tout, &reached, y_, yp_, IDA_NORMAL) >= 0 && IDAGetQuad(ida_, &reached, crossed_) >= 0)
+    return true;
+  // name the component whose residual went non-finite on the way, if one did
+  char note[300];
+  if (assembler_.describeNonFinite(model_, note, sizeof note) > 0) error_ += std::string("; ") + note;
+  return false;
 }
 
 double IdaProblem::lastStep() const {

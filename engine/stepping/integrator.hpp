@@ -41,7 +41,7 @@ struct StepOutcome {
   Flows energy;            // crossed during the step (J)
   // what failed last (also when a cut-back then succeeded); a fixed buffer, so that a
   // recovered Newton failure does not allocate
-  char failure[200] = "";
+  char failure[400] = "";
 };
 
 class Integrator {
