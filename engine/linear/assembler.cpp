@@ -134,9 +134,10 @@ void Assembler::updateRowScale(const Eigen::VectorXd& stateScale) {
 int Assembler::describeNonFinite(const Model& model, char* out, std::size_t size) const {
   if (firstNonFinite_.component < 0 || size == 0) return 0;
   const std::string_view block = blockName(model.layout().blockOf(firstNonFinite_.dof));
-  const int written = std::snprintf(out, size, "the residual of %s at dof %d (%.*s) was not finite",
-                                    model.components()[firstNonFinite_.component]->name().c_str(), firstNonFinite_.dof,
-                                    static_cast<int>(block.size()), block.data());
+  const int written =
+      std::snprintf(out, size, "the residual of %s at dof %d (%.*s) was not finite at an iterate or trial of this step",
+                    model.components()[firstNonFinite_.component]->name().c_str(), firstNonFinite_.dof,
+                    static_cast<int>(block.size()), block.data());
   return written < 0 ? 0 : std::min(written, static_cast<int>(size) - 1);
 }
 

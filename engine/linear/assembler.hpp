@@ -97,7 +97,7 @@ class Assembler {
   };
   const NonFiniteEntry& firstNonFinite() const { return firstNonFinite_; }
   void forgetNonFinite() { firstNonFinite_ = {}; }
-  // Write "the residual of <component> at dof <k> (<block>) was not finite" into `out` (without
+  // Write "the residual of <component> at dof <k> (<block>) was not finite ..." into `out` (without
   // allocating: the failure path of a step that a cut-back may still recover); returns the
   // characters written, 0 if no entry was seen.
   int describeNonFinite(const Model& model, char* out, std::size_t size) const;

@@ -197,7 +197,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
       summary.failed = true;
       summary.failedStep = accepted + 1;
       summary.failedTime = t;
-      char what[320];
+      char what[sizeof newtonFailure + 100];
       std::snprintf(what, sizeof what, "adaptive step fell below %.3g (the last one tried, %.3g, %s)", smallest, dt,
                     std::isfinite(error) ? "failed the error test" : newtonFailure);
       summary.failure = what;

@@ -17,7 +17,7 @@ double NodalThermalVariable::fromTemperature(double theta) const {
   return kind_ == ThermalVariable::Temperature ? theta : capacity_ * std::log(theta / referenceTemperature_);
 }
 
-// expm1 and log keep the small departures from theta_R free of cancellation
+// expm1 keeps the entropy form's small departures from theta_R free of cancellation
 double NodalThermalVariable::energy(double s) const {
   if (kind_ == ThermalVariable::Temperature) return capacity_ * (s - referenceTemperature_);
   return capacity_ * referenceTemperature_ * std::expm1(s / capacity_);

@@ -4,7 +4,8 @@
 // s = kappa ln(theta / theta_R) (entropy form), in which the capacity's energy
 // kappa theta_R (exp(s / kappa) - 1) is in closed form. Every component that touches a solid's
 // thermal dofs reads its temperatures through this class, so both forms assemble the same rows
-// and differ only in the unknown Newton solves for.
+// and differ only in the unknown Newton solves for. (Prescribed temperatures, which the
+// assembler imposes on the dof itself, exist in the temperature form only.)
 #include "engine/core/model.hpp"
 
 namespace mpx {

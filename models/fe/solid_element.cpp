@@ -48,7 +48,7 @@ struct SolidElement::PointEvaluation {
   double gammaRateCoefficient = 0.0;             // its derivative: 1/dt or beta
   double tangentScale = 1.0;                     // 1 or alpha
   // thermal cells: the point's temperature theta = sum_a N_a T_a, its derivative with respect
-  // to each node's temperature dof, the coupling stress per unit (theta_R - theta) and the rate
+  // to each node's thermal dof, the coupling stress per unit (theta_R - theta) and the rate
   // of the coupling entropy 3 beta K ln J
   double temperature = 0.0;
   ShapeValues temperatureSlope = ShapeValues::Zero();
@@ -58,7 +58,8 @@ struct SolidElement::PointEvaluation {
   double fluidity = 0.0, fluiditySlope = 0.0;
 };
 
-// The nodal temperatures T_a the heat rows are weighted with and their derivatives dT_a/dtheta_a.
+// The nodal temperatures T_a the heat rows are weighted with and their derivatives dT_a/ds_a in
+// the nodes' thermal dofs s_a (unscaled: the rate form applies alpha through tangentScale).
 struct SolidElement::NodeTemperatures {
   ShapeValues value = ShapeValues::Zero();
   ShapeValues slope = ShapeValues::Zero();

@@ -24,11 +24,11 @@ class XmlTextCheck {
       if (c == '\n') ++line_;
       if (state == State::Text) {
         if (startsWith("<!--")) {
-          skipPast("-->");
+          skipPast("<!--", "-->");
         } else if (startsWith("<![CDATA[")) {
-          skipPast("]]>");
+          skipPast("<![CDATA[", "]]>");
         } else if (startsWith("<?")) {
-          skipPast("?>");
+          skipPast("<?", "?>");
         } else if (startsWith("<!")) {
           fail("document type declarations are not supported (their entities would not be expanded)");
         } else if (c == '<') {
@@ -54,10 +54,10 @@ class XmlTextCheck {
     return text_.compare(i_, std::char_traits<char>::length(prefix), prefix) == 0;
   }
 
-  // Leave i_ on the last character of `terminator` (or at the end: tinyxml2 reports the
-  // unterminated construct), counting the lines passed.
-  void skipPast(const char* terminator) {
-    const std::size_t end = text_.find(terminator, i_ + 1);
+  // i_ is on `opener`: leave it on the last character of the first `terminator` after the
+  // opener (or at the end: tinyxml2 reports the unterminated construct), counting the lines passed.
+  void skipPast(const char* opener, const char* terminator) {
+    const std::size_t end = text_.find(terminator, i_ + std::char_traits<char>::length(opener));
     const std::size_t stop =
         end == std::string::npos ? text_.size() : end + std::char_traits<char>::length(terminator) - 1;
     for (std::size_t k = i_ + 1; k < stop && k < text_.size(); ++k)
@@ -69,20 +69,21 @@ class XmlTextCheck {
   // character (#x9, #xA, #xD, #x20-#xD7FF, #xE000-#xFFFD, #x10000-#x10FFFF).
   void checkReference() {
     const std::size_t end = text_.find(';', i_);
-    if (end == std::string::npos || end - i_ > 12) fail("'&' that starts no reference (write &amp;)");
+    if (end == std::string::npos || end - i_ > 64) fail("'&' that starts no reference (write &amp;)");
     const std::string name = text_.substr(i_ + 1, end - i_ - 1);
     for (const char* entity : {"lt", "gt", "amp", "apos", "quot"})
       if (name == entity) return;
+    const std::string shown = name.substr(0, 16);
     if (name.size() < 2 || name[0] != '#')
-      fail("undefined entity '&" + name + ";' (XML predefines only lt, gt, amp, apos, quot)");
+      fail("undefined entity '&" + shown + ";' (XML predefines only lt, gt, amp, apos, quot)");
     const bool hex = name[1] == 'x';
     const std::string digits = name.substr(hex ? 2 : 1);
-    char* stop = nullptr;
-    const unsigned long code = digits.empty() ? 0 : std::strtoul(digits.c_str(), &stop, hex ? 16 : 10);
-    const bool parsed = !digits.empty() && *stop == '\0' && digits.find_first_of("+- ") == std::string::npos;
+    const bool parsed = !digits.empty() && digits.size() <= 16 &&
+                        digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") == std::string::npos;
+    const unsigned long code = parsed ? std::strtoul(digits.c_str(), nullptr, hex ? 16 : 10) : 0;
     const bool valid = code == 0x9 || code == 0xA || code == 0xD || (code >= 0x20 && code <= 0xD7FF) ||
                        (code >= 0xE000 && code <= 0xFFFD) || (code >= 0x10000 && code <= 0x10FFFF);
-    if (!parsed || !valid) fail("invalid character reference '&" + name + ";'");
+    if (!parsed || !valid) fail("invalid character reference '&" + shown + ";'");
   }
 
   [[noreturn]] void fail(const std::string& message) const { throw InputError(label_, line_, message); }
@@ -93,10 +94,11 @@ class XmlTextCheck {
   int line_ = 1;
 };
 
-// Text outside attribute values carries no meaning in a scene or a URDF: reject it rather than
-// ignore it (an iterative walk: the element nesting is the file's, however deep).
-void rejectText(const tinyxml2::XMLElement& root, const std::string& label) {
-  std::vector<const tinyxml2::XMLNode*> pending = {&root};
+// Text outside attribute values carries no meaning in a scene: reject it rather than ignore it,
+// also before and after the root (an iterative walk: the element nesting is the file's, however
+// deep).
+void rejectText(const tinyxml2::XMLDocument& document, const std::string& label) {
+  std::vector<const tinyxml2::XMLNode*> pending = {&document};
   while (!pending.empty()) {
     const tinyxml2::XMLNode* node = pending.back();
     pending.pop_back();
@@ -107,8 +109,9 @@ void rejectText(const tinyxml2::XMLElement& root, const std::string& label) {
         if (first == std::string::npos) continue;
         const std::size_t last = value.find_last_not_of(" \t\r\n");
         throw InputError(label, text->GetLineNum(),
-                         "unexpected text '" + value.substr(first, std::min<std::size_t>(last + 1 - first, 32)) +
-                             "' inside <" + node->Value() + ">");
+                         "unexpected text '" + value.substr(first, std::min<std::size_t>(last + 1 - first, 32)) + "'" +
+                             (node->ToElement() ? std::string(" inside <") + node->Value() + ">"
+                                                : std::string(" outside the root element")));
       } else if (child->ToElement()) {
         pending.push_back(child);
       }
@@ -119,7 +122,7 @@ void rejectText(const tinyxml2::XMLElement& root, const std::string& label) {
 }  // namespace
 
 const tinyxml2::XMLElement& parseStrictXml(tinyxml2::XMLDocument& document, const std::string& text,
-                                           const std::string& label) {
+                                           const std::string& label, TextContent textContent) {
   XmlTextCheck(text, label).run();
   document.Parse(text.c_str(), text.size());
   if (document.Error())
@@ -129,7 +132,7 @@ const tinyxml2::XMLElement& parseStrictXml(tinyxml2::XMLDocument& document, cons
   if (const tinyxml2::XMLElement* second = root->NextSiblingElement())
     throw InputError(label, second->GetLineNum(),
                      std::string("a second root element <") + second->Name() + "> after <" + root->Name() + ">");
-  rejectText(*root, label);
+  if (textContent == TextContent::Refused) rejectText(document, label);
   return *root;
 }
 

@@ -6,7 +6,9 @@
 //   references to valid XML characters; tinyxml2 keeps an undeclared "&foo;" as literal text;
 // - no '<' inside an attribute value;
 // - no document type declaration, whose entity definitions tinyxml2 would not expand;
-// - exactly one root element, and no text outside attribute values.
+// - exactly one root element;
+// - for scenes, no text outside attribute values (a URDF's <gazebo> and <transmission> hold
+//   text, which the importer ignores).
 // A violation throws an InputError naming the file and line.
 #include <tinyxml2.h>
 
@@ -14,8 +16,10 @@
 
 namespace mpx {
 
+enum class TextContent { Refused, Allowed };
+
 // Parse `text` (read from `label`) into `document` and return its root element.
 const tinyxml2::XMLElement& parseStrictXml(tinyxml2::XMLDocument& document, const std::string& text,
-                                           const std::string& label);
+                                           const std::string& label, TextContent textContent);
 
 }  // namespace mpx

@@ -83,7 +83,7 @@ class UrdfFile {
     text << file.rdbuf();
     text_ = text.str();
     tinyxml2::XMLDocument document;
-    const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_);
+    const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_, TextContent::Allowed);
     for (const tinyxml2::XMLElement* e = robot.FirstChildElement(); e; e = e->NextSiblingElement())
       if (const char* name = e->Attribute("name")) lines_.emplace(key(e->Name(), name), e->GetLineNum());
   }

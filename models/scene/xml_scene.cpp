@@ -178,7 +178,7 @@ class XmlSceneReader {
 
 SceneSpec readXmlScene(const std::string& text, const std::string& label) {
   tinyxml2::XMLDocument document;
-  return XmlSceneReader(parseStrictXml(document, text, label), label).read();
+  return XmlSceneReader(parseStrictXml(document, text, label, TextContent::Refused), label).read();
 }
 
 }  // namespace mpx
