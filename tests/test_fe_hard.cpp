@@ -121,9 +121,11 @@ struct HotBarFigures {
 HotBarFigures hotBarFigures(const CompiledScene& scene, const History& h) {
   HotBarFigures f;
   for (std::size_t n = 0; n < h.states.size(); ++n) {
-    for (int dof : scene.solids.front().thermalDofs) {
-      f.lowest = std::min(f.lowest, h.states[n][dof]);
-      f.highest = std::max(f.highest, h.states[n][dof]);
+    const SolidPlacement& bar = scene.solids.front();
+    for (std::size_t a = 0; a < bar.thermalDofs.size(); ++a) {
+      const double theta = bar.nodeTemperature(h.states[n].data(), static_cast<int>(a));
+      f.lowest = std::min(f.lowest, theta);
+      f.highest = std::max(f.highest, theta);
     }
     if (n == 0) continue;
     f.leastProduction = std::min(f.leastProduction,

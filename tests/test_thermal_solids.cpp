@@ -213,7 +213,7 @@ double barError(int cells, double dt, double tEnd) {
   double sum = 0.0;
   for (std::size_t n = 0; n < bar.mesh->nodes.size(); ++n) {
     const double x = bar.mesh->nodes[n].x();
-    const double error = h.states.back()[bar.thermalDofs[n]] - barTemperature(x, tEnd);
+    const double error = bar.nodeTemperature(h.states.back().data(), static_cast<int>(n)) - barTemperature(x, tEnd);
     sum += error * error / (4.0 * cells);  // four nodes per x-station
   }
   return std::sqrt(sum);
@@ -428,10 +428,11 @@ TEST(CooledFlexiblePendulum, KeepsTheEnergyAndProducesEntropyWhileTheLinkCools) 
   const CompiledScene scene = loadScene(scenePath("cooled_flexible_pendulum.xml"));
   const History h = run(*scene.model, Scheme::Eem, 0.005, 1.0, scene.settings.newton);
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  const std::vector<int>& dofs = scene.solids.front().thermalDofs;
+  const SolidPlacement& link = scene.solids.front();
   const auto meanTemperature = [&](const VectorXd& z) {
+    const int nodes = static_cast<int>(link.thermalDofs.size());
     double sum = 0.0;
-    for (int dof : dofs) sum += z[dof] / static_cast<double>(dofs.size());
+    for (int a = 0; a < nodes; ++a) sum += link.nodeTemperature(z.data(), a) / nodes;
     return sum;
   };
   std::printf("cooled flexible pendulum: energy drift %.2e of %.3e, link mean temperature %.2f -> %.2f K\n",
