@@ -56,16 +56,10 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   // a failure names the component and dof whose residual went non-finite in this step, if any
   assembler_.forgetNonFinite();
   auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
-    const int written =
-        std::snprintf(outcome.failure, sizeof outcome.failure, "%s (Newton iteration %d, increment %.3g, residual %.3g",
-                      what, iteration, incrementNorm, residualNorm);
-    char* end = outcome.failure + std::min<std::size_t>(std::max(written, 0), sizeof outcome.failure - 1);
-    const std::size_t left = outcome.failure + sizeof outcome.failure - end;
-    if (assembler_.firstNonFinite().component >= 0 && left > 3) {
-      std::snprintf(end, left, "; ");
-      end += assembler_.describeNonFinite(model_, end + 2, left - 2) + 2;
-    }
-    std::snprintf(end, outcome.failure + sizeof outcome.failure - end, ")");
+    char note[300] = "";
+    if (assembler_.describeNonFinite(model_, note + 2, sizeof note - 2) > 0) note[0] = ';', note[1] = ' ';
+    std::snprintf(outcome.failure, sizeof outcome.failure, "%s (Newton iteration %d, increment %.3g, residual %.3g%s)",
+                  what, iteration, incrementNorm, residualNorm, note);
     return false;
   };
   // the residual norm relative to row scales taken at the current iterate
