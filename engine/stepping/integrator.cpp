@@ -56,7 +56,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   // a failure names the component and dof whose residual went non-finite in this step, if any
   assembler_.forgetNonFinite();
   auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
-    char note[300] = "";
+    char note[200] = "";
     if (assembler_.describeNonFinite(model_, note + 2, sizeof note - 2) > 0) note[0] = ';', note[1] = ' ';
     std::snprintf(outcome.failure, sizeof outcome.failure, "%s (Newton iteration %d, increment %.3g, residual %.3g%s)",
                   what, iteration, incrementNorm, residualNorm, note);
