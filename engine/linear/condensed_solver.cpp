@@ -30,17 +30,22 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   auto isPosition = [&](int dof) { return dof < nv; };
   auto isVelocity = [&](int dof) { return dof >= nv && dof < 2 * nv; };
 
-  // kinematic rows: their entries in kept columns, and the single velocity entry d_i
+  // kinematic rows: their entries in kept columns (by row, and by column for the condensation),
+  // and the single velocity entry d_i
   kinematicRows_.assign(nv, {});
   pivotEntry_.assign(nv, -1);
-  for (int column = 0; column < n; ++column)
+  kinematicColumnStart_.assign(n + 1, 0);
+  kinematicColumns_.clear();
+  for (int column = 0; column < n; ++column) {
+    kinematicColumnStart_[column] = static_cast<int>(kinematicColumns_.size());
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
       const int row = static_cast<int>(it.row());
       if (!isPosition(row)) continue;
       const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
-      if (!isVelocity(column))
+      if (!isVelocity(column)) {
         kinematicRows_[row].push_back({column, entry});
-      else if (column - nv == row)
+        kinematicColumns_.push_back({row, entry});
+      } else if (column - nv == row)
         pivotEntry_[row] = entry;
       else {
         wholeSystemReason_ = "the kinematic row of position dof " + std::to_string(row) + " couples to velocity dof " +
@@ -48,44 +53,40 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
         return false;
       }
     }
+  }
+  kinematicColumnStart_[n] = static_cast<int>(kinematicColumns_.size());
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
     wholeSystemReason_ =
         "position dof " + std::to_string(missing - pivotEntry_.begin()) + " has no kinematic row (no inertia owns it)";
     return false;
   }
 
-  // condensed pattern: kept entries of K, plus the fill of the products K(j, v_i) K(q_i, c)
+  // condensed pattern, a column at a time: the kept entries of K, plus the fill of the
+  // products K(j, v_i) K(q_i, c), each entry once (the products are many times the entries)
   std::vector<Eigen::Triplet<double>> entries;
-  for (int column = 0; column < n; ++column)
-    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
-      const int row = static_cast<int>(it.row());
-      if (isPosition(row)) continue;
-      if (!isVelocity(column)) {
-        entries.emplace_back(reducedRow(row), reducedColumn(column), 0.0);
-        continue;
-      }
-      for (const RowEntry& kinematic : kinematicRows_[column - nv])
-        entries.emplace_back(reducedRow(row), reducedColumn(kinematic.column), 0.0);
+  std::vector<int> rows;
+  std::vector<char> seen(n - nv, 0);
+  auto mark = [&](int row) {
+    if (row < nv || seen[reducedRow(row)]) return;
+    seen[reducedRow(row)] = 1;
+    rows.push_back(reducedRow(row));
+  };
+  for (int column = 0; column < n; ++column) {
+    if (isVelocity(column)) continue;
+    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) mark(static_cast<int>(it.row()));
+    for (int k = kinematicColumnStart_[column]; k < kinematicColumnStart_[column + 1]; ++k)
+      for (SparseMatrix::InnerIterator it(pattern, nv + kinematicColumns_[k].position); it; ++it)
+        mark(static_cast<int>(it.row()));
+    for (const int row : rows) {
+      entries.emplace_back(row, reducedColumn(column), 0.0);
+      seen[row] = 0;
     }
+    rows.clear();
+  }
   reduced_.resize(n - nv, n - nv);
   reduced_.setFromTriplets(entries.begin(), entries.end());
   reduced_.makeCompressed();
-
-  // where each kept entry and each product term lands in the condensed values
-  for (int column = 0; column < n; ++column)
-    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
-      const int row = static_cast<int>(it.row());
-      if (isPosition(row)) continue;
-      const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
-      if (!isVelocity(column)) {
-        directEntries_.emplace_back(entry, findEntry(reduced_, reducedRow(row), reducedColumn(column)));
-        continue;
-      }
-      const int i = column - nv;
-      for (const RowEntry& kinematic : kinematicRows_[i])
-        productTerms_.push_back({entry, kinematic.entry, pivotEntry_[i],
-                                 findEntry(reduced_, reducedRow(row), reducedColumn(kinematic.column))});
-    }
+  condensedColumn_.setZero(n - nv);
   return true;
 }
 
@@ -98,11 +99,28 @@ bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
 
 void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
   const double* k = tangent.valuePtr();
+  const int n = static_cast<int>(tangent.rows()), nv = velocities_;
   double* reduced = reduced_.valuePtr();
-  std::fill_n(reduced, reduced_.nonZeros(), 0.0);
-  for (const auto& [entry, reducedEntry] : directEntries_) reduced[reducedEntry] += k[entry];
-  for (const ProductTerm& term : productTerms_)
-    reduced[term.reducedEntry] -= k[term.velocityEntry] * k[term.kinematicEntry] / k[term.pivotEntry];
+  // each condensed column in a dense work column: K(j, c), minus the products in the order of
+  // i, then copied into the condensed values (the work column is zero again afterwards)
+  for (int column = 0; column < n; ++column) {
+    if (column >= nv && column < 2 * nv) continue;
+    for (SparseMatrix::InnerIterator it(tangent, column); it; ++it)
+      if (it.row() >= nv) condensedColumn_[reducedRow(static_cast<int>(it.row()))] += it.value();
+    for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
+      const auto [i, kinematicEntry] = kinematicColumns_[term];
+      for (SparseMatrix::InnerIterator it(tangent, nv + i); it; ++it)
+        if (it.row() >= nv)
+          condensedColumn_[reducedRow(static_cast<int>(it.row()))] -=
+              it.value() * k[kinematicEntry] / k[pivotEntry_[i]];
+    }
+    const int target = reducedColumn(column);
+    for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e) {
+      double& value = condensedColumn_[reduced_.innerIndexPtr()[e]];
+      reduced[e] = value;
+      value = 0.0;
+    }
+  }
 }
 
 void CondensedSolver::solveVelocityCondensed(Eigen::VectorXd& rhs) {

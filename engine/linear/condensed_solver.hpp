@@ -42,13 +42,13 @@ class CondensedSolver {
   std::string describe() const;
 
  private:
-  // One term K(j, v_i) K(q_i, c) / d_i of the condensed entry (j, c).
-  struct ProductTerm {
-    int velocityEntry, kinematicEntry, pivotEntry, reducedEntry;
-  };
   // An entry of a kinematic row q_i off its velocity: column c (a kept dof) and its place in K.
   struct RowEntry {
     int column, entry;
+  };
+  // The same entry seen from its column: the position dof q_i of its row and its place in K.
+  struct ColumnEntry {
+    int position, entry;
   };
   bool buildCondensation(const Eigen::SparseMatrix<double>& pattern);
   void condenseVelocities(const Eigen::SparseMatrix<double>& tangent);
@@ -68,10 +68,13 @@ class CondensedSolver {
   const Eigen::SparseMatrix<double>* pattern_;
   const Eigen::SparseMatrix<double>* tangent_ = nullptr;
   Eigen::SparseMatrix<double> reduced_;
-  std::vector<std::pair<int, int>> directEntries_;  // (entry in K, entry in the condensed matrix)
-  std::vector<ProductTerm> productTerms_;
   std::vector<int> pivotEntry_;                       // per q_i: position of d_i in K
   std::vector<std::vector<RowEntry>> kinematicRows_;  // per q_i
+  // the kinematic entries of column c of K are kinematicColumns_[kinematicColumnStart_[c] ...
+  // kinematicColumnStart_[c + 1]), in the order of i
+  std::vector<ColumnEntry> kinematicColumns_;
+  std::vector<int> kinematicColumnStart_;
+  Eigen::VectorXd condensedColumn_;  // zero between uses
   Eigen::VectorXd reducedRhs_;
   GroupElimination internal_;
   Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
