@@ -2,6 +2,7 @@
 // alone, a URDF pendulum swings with the analytic compound-pendulum period, every kind of
 // invalid URDF is rejected with exit code 2 and a message naming the element, the planar joint
 // leaves exactly the in-plane motion free, and the URDF scenes run, conserving energy under EEM.
+#include "models/scene/urdf_scene.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -502,6 +503,28 @@ TEST(UrdfScenes, DampedArmBalancesEnergyAndDissipation) {
               h.dissipated.back(), h.summary.maxEnergyBalanceError);
   EXPECT_GT(h.dissipated.back(), 0.01 * std::abs(h.energy.front()));  // the URDF damping acts
   EXPECT_LT(h.summary.maxEnergyBalanceError, 1e-10);
+}
+
+// A chain deeper than a recursive walk's call stack (one 8 MB stack held about 15 000 links)
+// imports in tree order: each link's body and joint right after its parent's.
+TEST_F(UrdfTest, ChainOfThirtyThousandLinksImportsParentsFirst) {
+  constexpr int kLinks = 30000;
+  std::vector<std::string> elements{kWorld};
+  for (int i = 1; i <= kLinks; ++i) {
+    const std::string name = "l" + std::to_string(i), parent = i == 1 ? "world" : "l" + std::to_string(i - 1);
+    elements.push_back(linkWith(name, "1", kBox));
+    elements.push_back(jointWith("j" + std::to_string(i), "continuous", parent, name));
+  }
+  const SceneSpec scene = readUrdfScene(write("deep.urdf", robotWith(elements)).string());
+  ASSERT_EQ(scene.elements.size(), 1u + 2u * kLinks) << "the world anchor, then a body and a joint per link";
+  for (int i = 1; i <= kLinks; i += 997) {
+    const ElementSpec& body = scene.elements[2 * i - 1];
+    const ElementSpec& joint = scene.elements[2 * i];
+    ASSERT_EQ(body.tag, "body");
+    EXPECT_EQ(*body.find("name"), "l" + std::to_string(i));
+    ASSERT_EQ(joint.tag, "joint");
+    EXPECT_EQ(*joint.find("b"), "l" + std::to_string(i));
+  }
 }
 
 // (with the text of <gazebo> and <transmission> elements, which the importer ignores)

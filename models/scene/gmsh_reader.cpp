@@ -1,14 +1,15 @@
 #include "models/scene/gmsh_reader.hpp"
 
 #include "engine/core/input_error.hpp"
+#include "models/scene/input_file.hpp"
 
 #include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <numeric>
+#include <sstream>
 #include <unordered_map>
 
 namespace mpx {
@@ -490,8 +491,7 @@ class GmshParser {
 }  // namespace
 
 Mesh readGmshMesh(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw InputError(path + ": cannot open the Gmsh mesh file");
+  std::istringstream file(readInputFile(path, "Gmsh mesh file"));
   std::vector<std::string> lines;
   for (std::string line; std::getline(file, line);) lines.push_back(line);
   return GmshParser(path, std::move(lines)).parse();

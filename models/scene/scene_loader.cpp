@@ -2,12 +2,11 @@
 
 #include "engine/stepping/method.hpp"
 
+#include "models/scene/input_file.hpp"
 #include "models/scene/urdf_scene.hpp"
 #include "models/scene/xml_scene.hpp"
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace mpx {
 
@@ -109,11 +108,7 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
 
 SceneSpec readScene(const std::string& path) {
   if (std::filesystem::path(path).extension() == ".urdf") return readUrdfScene(path);
-  std::ifstream file(path);
-  if (!file) throw InputError(path + ": cannot open the scene file");
-  std::stringstream text;
-  text << file.rdbuf();
-  return readXmlScene(text.str(), path);
+  return readXmlScene(readInputFile(path, "scene file"), path);
 }
 
 CompiledScene loadScene(const std::string& path, std::optional<ThermalVariable> thermalVariable) {

@@ -1,6 +1,7 @@
 #include "models/scene/urdf_import.hpp"
 
 #include "engine/core/input_error.hpp"
+#include "models/scene/input_file.hpp"
 
 #include "models/scene/strict_xml.hpp"
 
@@ -11,10 +12,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iostream>
-#include <sstream>
+#include <utility>
 #include <vector>
 
 namespace mpx {
@@ -39,10 +40,12 @@ Pose toEigen(const urdf::Pose& p) {
 std::string numbers(const Vec3& v) { return AttributeValue(v).text(); }
 std::string number(double value) { return AttributeValue(value).text(); }
 
-// 'a', 'b', 'c' for messages.
+// 'a', 'b', 'c' for messages; a long list is cut after the first few names.
 std::string quotedList(const std::vector<std::string>& names) {
+  constexpr std::size_t kListed = 8;
   std::string list;
-  for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+  for (std::size_t i = 0; i < std::min(names.size(), kListed); ++i) list += (i == 0 ? "'" : ", '") + names[i] + "'";
+  if (names.size() > kListed) list += " and " + std::to_string(names.size() - kListed) + " more";
   return list;
 }
 
@@ -76,12 +79,7 @@ const char* sceneJointType(const urdf::Joint& joint) {
 // numbers, so messages find them here.
 class UrdfFile {
  public:
-  explicit UrdfFile(std::string path) : path_(std::move(path)) {
-    std::ifstream file(path_);
-    if (!file) throw InputError(path_ + ": cannot open the URDF file");
-    std::stringstream text;
-    text << file.rdbuf();
-    text_ = text.str();
+  explicit UrdfFile(std::string path) : path_(std::move(path)), text_(readInputFile(path_, "URDF file")) {
     tinyxml2::XMLDocument document;
     const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_, TextContent::Allowed);
     for (const tinyxml2::XMLElement* e = robot.FirstChildElement(); e; e = e->NextSiblingElement())
@@ -163,7 +161,9 @@ class UrdfTranslator {
   // Joint names must not be link names; initial states must name joints with a coordinate.
   void checkNames() const;
   std::string addRoot(const urdf::Link& root, const LinkState& state);
-  void addChildren(const urdf::Link& parent, const LinkState& parentState);
+  void addDescendants(const urdf::Link& root, const LinkState& rootState);
+  // Emits `child`, reached from its parent through `joint`; returns its state.
+  LinkState addChild(const urdf::Joint& joint, const urdf::Link& child, const LinkState& parentState);
   LinkState childState(const urdf::Joint& joint, const LinkState& parent) const;
   UrdfJointState initialState(const urdf::Joint& joint) const;
   Vec3 unitAxis(const urdf::Joint& joint) const;
@@ -192,7 +192,7 @@ void UrdfTranslator::translate() {
   state.frame = Eigen::Translation3d(options_.position) * options_.orientation;
   state.carrier = addRoot(root, state);
   parentJoint_[root.name] = "";
-  addChildren(root, state);
+  addDescendants(root, state);
   // urdfdom accepts links that a cycle of joints keeps away from the root
   for (const auto& [name, link] : robot_.links_)
     if (!parentJoint_.count(name))
@@ -238,34 +238,47 @@ std::string UrdfTranslator::addRoot(const urdf::Link& root, const LinkState& sta
   return sceneName(root.name);
 }
 
-void UrdfTranslator::addChildren(const urdf::Link& parent, const LinkState& parentState) {
-  for (const urdf::JointSharedPtr& joint : parent.child_joints) {
+void UrdfTranslator::addDescendants(const urdf::Link& root, const LinkState& rootState) {
+  // depth first with an explicit stack (a chain of links may be deeper than the call stack), in
+  // the order of a recursive walk: a link's whole subtree before its next sibling
+  std::vector<std::pair<const urdf::Joint*, LinkState>> pending;
+  auto pushChildJoints = [&](const urdf::Link& parent, const LinkState& state) {
+    for (auto joint = parent.child_joints.rbegin(); joint != parent.child_joints.rend(); ++joint)
+      pending.emplace_back(joint->get(), state);
+  };
+  pushChildJoints(root, rootState);
+  while (!pending.empty()) {
+    const auto [joint, parentState] = std::move(pending.back());
+    pending.pop_back();
     const urdf::Link& child = *robot_.getLink(joint->child_link_name);
-    const auto [reached, first] = parentJoint_.emplace(child.name, joint->name);
-    if (!first)
-      file_.fail(
-          "link", child.name,
-          "is the child of two joints, '" + reached->second + "' and '" + joint->name + "': a URDF must be a tree");
-    if (joint->mimic)
-      file_.fail("joint", joint->name,
-                 "mimics joint '" + joint->mimic->joint_name +
-                     "': mimic joints are not supported (import it as an independent joint)");
-    LinkState state = childState(*joint, parentState);
-    if (massless(child)) {
-      // a massless link rigidly fixed to its parent is merged into the parent's carrier
-      if (joint->type != urdf::Joint::FIXED)
-        file_.fail("link", child.name,
-                   "has no mass (no <inertial>, or mass and inertia 0) but joint '" + joint->name +
-                       "' moves it: give it a positive mass or fix it to its parent");
-      state.carrier = parentState.carrier;
-    } else {
-      addBody(child, state);
-      state.carrier = sceneName(child.name);
-      if (joint->type != urdf::Joint::FLOATING) addJoint(*joint, parentState, state);
-    }
-    addDynamics(*joint);
-    addChildren(child, state);
+    pushChildJoints(child, addChild(*joint, child, parentState));
   }
+}
+
+LinkState UrdfTranslator::addChild(const urdf::Joint& joint, const urdf::Link& child, const LinkState& parentState) {
+  const auto [reached, first] = parentJoint_.emplace(child.name, joint.name);
+  if (!first)
+    file_.fail("link", child.name,
+               "is the child of two joints, '" + reached->second + "' and '" + joint.name + "': a URDF must be a tree");
+  if (joint.mimic)
+    file_.fail("joint", joint.name,
+               "mimics joint '" + joint.mimic->joint_name +
+                   "': mimic joints are not supported (import it as an independent joint)");
+  LinkState state = childState(joint, parentState);
+  if (massless(child)) {
+    // a massless link rigidly fixed to its parent is merged into the parent's carrier
+    if (joint.type != urdf::Joint::FIXED)
+      file_.fail("link", child.name,
+                 "has no mass (no <inertial>, or mass and inertia 0) but joint '" + joint.name +
+                     "' moves it: give it a positive mass or fix it to its parent");
+    state.carrier = parentState.carrier;
+  } else {
+    addBody(child, state);
+    state.carrier = sceneName(child.name);
+    if (joint.type != urdf::Joint::FLOATING) addJoint(joint, parentState, state);
+  }
+  addDynamics(joint);
+  return state;
 }
 
 LinkState UrdfTranslator::childState(const urdf::Joint& joint, const LinkState& parent) const {
