@@ -17,7 +17,11 @@ using namespace mpx;
 std::vector<std::string> splitNames(const std::string& list) {
   std::vector<std::string> names;
   std::stringstream stream(list);
-  for (std::string name; std::getline(stream, name, ',');) names.push_back(name);
+  for (std::string name; std::getline(stream, name, ',');) {
+    // an empty name would silently stand for the scene's own integrator
+    if (name.empty()) throw InputError("option --integrators: an empty name in '" + list.substr(0, 64) + "'");
+    names.push_back(name);
+  }
   return names;
 }
 

@@ -3,7 +3,9 @@
 #include "engine/core/input_error.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 namespace mpx {
@@ -22,6 +24,12 @@ class XmlTextCheck {
     for (; i_ < text_.size(); ++i_) {
       const char c = text_[i_];
       if (c == '\n') ++line_;
+      // XML 1.0 allows no control characters but tab, newline and carriage return
+      if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r') {
+        char code[8];
+        std::snprintf(code, sizeof code, "0x%02X", static_cast<unsigned>(c));
+        fail(std::string("control character ") + code + " is not allowed in XML (is this a binary file?)");
+      }
       if (state == State::Text) {
         if (startsWith("<!--")) {
           skipPast("<!--", "-->");
@@ -119,14 +127,38 @@ void rejectText(const tinyxml2::XMLDocument& document, const std::string& label)
   }
 }
 
+// What tinyxml2 found wrong, in words for its common errors, with the element it was in.
+std::string malformedXml(const tinyxml2::XMLDocument& document) {
+  const char* what = nullptr;
+  switch (document.ErrorID()) {
+    case tinyxml2::XML_ERROR_EMPTY_DOCUMENT:
+      return "the file is empty (no XML element)";
+    case tinyxml2::XML_ERROR_PARSING_ATTRIBUTE:
+      what = "an attribute is not name=\"value\", or is given twice";
+      break;
+    case tinyxml2::XML_ERROR_MISMATCHED_ELEMENT:
+      what = "an element is closed by another name, or not closed";
+      break;
+    case tinyxml2::XML_ERROR_PARSING_TEXT:
+      what = "text where an element was expected";
+      break;
+    default:
+      what = document.ErrorName();
+  }
+  // tinyxml2's own text ends with the element it was reading ("... XMLElement name=mass")
+  const std::string detail = document.ErrorStr();
+  const std::size_t element = detail.find("XMLElement name=");
+  return std::string("malformed XML: ") + what +
+         (element == std::string::npos ? "" : " (in <" + detail.substr(element + 16, 64) + ">)");
+}
+
 }  // namespace
 
 const tinyxml2::XMLElement& parseStrictXml(tinyxml2::XMLDocument& document, const std::string& text,
                                            const std::string& label, TextContent textContent) {
   XmlTextCheck(text, label).run();
   document.Parse(text.c_str(), text.size());
-  if (document.Error())
-    throw InputError(label, document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
+  if (document.Error()) throw InputError(label, std::max(1, document.ErrorLineNum()), malformedXml(document));
   const tinyxml2::XMLElement* root = document.RootElement();
   if (!root) throw InputError(label, 1, "the file holds no XML element");
   if (const tinyxml2::XMLElement* second = root->NextSiblingElement())
