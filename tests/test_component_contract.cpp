@@ -3,7 +3,8 @@
 // What the engine promises: the tangent keeps only the pairs couples() allows (the bogus entry
 // is dropped when the component says it never writes kinematic rows), velocity condensation
 // stays on for such a component and is reported off, with the reason, for one that claims every
-// pair; flows of all components are summed.
+// pair; flows of all components are summed; a state whose measures are not finite stops every
+// time loop at that step, naming the component, before the history gets the row.
 #include "support.hpp"
 
 #include "models/multibody/inertia.hpp"
@@ -97,6 +98,52 @@ TEST(ComponentContract, FlowsOfAllComponentsAreSummed) {
   EXPECT_EQ(integrator.evaluate(z, z, 0.0, 0.1).flows().externalWork, 3 * kExternalPower);
   Integrator trapezoidal(*model, Scheme::Trapezoidal, NewtonSettings{});
   EXPECT_DOUBLE_EQ(trapezoidal.evaluate(z, z, 0.0, 0.1).flows().externalWork, 3 * kExternalPower);  // 2 x 1/2
+}
+
+// A gauge on a mass's x: it reads the state and adds the energy sqrt(x - kGaugeFloor), which is
+// NaN once x < kGaugeFloor, and writes no residual (the state stays acceptable to Newton).
+constexpr double kGaugeFloor = 0.45;
+class Gauge final : public Component {
+ public:
+  Gauge() : Component("gauge", {0}) {}
+  void measure(const double* z, Measures& out) const override { out.energy += std::sqrt(z[0] - kGaugeFloor); }
+  void eemLocal(const StepArgs&, Workspace&, LocalSystem&, Flows&) const override {}
+  void rateLocal(const RateArgs&, Workspace&, LocalSystem&, Flows&) const override {}
+};
+
+// One free mass moving from x = 1 at -1 m/s: x falls below kGaugeFloor in the step ending at t = 0.6.
+std::unique_ptr<Model> gaugedMass() {
+  std::vector<std::unique_ptr<Component>> components;
+  components.push_back(std::make_unique<Inertia>("m", 0, 3, std::vector<InertiaBlock>{{1.0, true}}, Vec3::Zero()));
+  components.push_back(std::make_unique<Gauge>());
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(6);
+  z[0] = 1.0;
+  z[3] = -1.0;
+  return std::make_unique<Model>(Layout({3, 3, 0, 0, 0}), ThermalVariable::Temperature, std::move(components),
+                                 std::vector<std::string>{}, z, Eigen::VectorXd::Ones(6));
+}
+
+TEST(ComponentContract, ANonFiniteMeasureStopsEveryTimeLoopAtItsStepNamingTheComponent) {
+  const auto model = gaugedMass();
+  for (const char* name : {"eem", "eem-adaptive", "ida"}) {
+    SCOPED_TRACE(name);
+    MethodParameters parameters;
+    parameters.dt = 0.1;
+    parameters.tEnd = 2.0;
+    parameters.adaptive = std::string(name) == "eem-adaptive";
+    double lastTime = -1.0;
+    const RunSummary summary =
+        runMethod(*model, *methodByName(name), parameters, [&](const StepRecord& record) { lastTime = record.time; });
+    ASSERT_TRUE(summary.failed);
+    EXPECT_NE(summary.failure.find("measured by gauge is not finite"), std::string::npos) << summary.failure;
+    // the history ends at the last finite state: x(t) = 1 - t stays above the floor to t = 0.55
+    EXPECT_LE(lastTime, 1.0 - kGaugeFloor + 1e-9);
+    if (std::string(name) == "eem") {
+      EXPECT_EQ(summary.failedStep, 6);
+      EXPECT_NEAR(summary.failedTime, 0.5, 1e-12);
+      EXPECT_NEAR(lastTime, 0.5, 1e-12);
+    }
+  }
 }
 
 }  // namespace

@@ -158,7 +158,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   auto accept = [&](Eigen::VectorXd& state, double time, double dt, const StepOutcome& outcome) {
     reporter.state().swap(state);
     crossed += outcome.energy;
-    reporter.report(++accepted, time, dt, crossed, outcome.iterations, outcome.cutbacks);
+    return reporter.report(++accepted, time, dt, crossed, outcome.iterations, outcome.cutbacks);
   };
 
   localError.restart(0.0, reporter.state());
@@ -204,10 +204,10 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
       break;
     }
     if (doubling) {
-      accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome);
+      if (!accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome)) break;
       localError.accept(t + 0.5 * dt, reporter.state());
     }
-    accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome);
+    if (!accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome)) break;
     // the next step from the last one taken and its own error (a half step of a doubling has
     // half the pair's); a step shortened to land may be followed by one up to the size
     // proposed before, as far as its error allows

@@ -313,9 +313,10 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
     }
     reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);
     const IdaStatistics stats = ida.statistics();
-    reporter.report(k, tout, ida.lastStep(), ida.crossed(),
-                    static_cast<int>(stats.nonlinearIterations - previousIterations),
-                    static_cast<int>(stats.errorTestFailures - previousErrorTestFailures));
+    if (!reporter.report(k, tout, ida.lastStep(), ida.crossed(),
+                         static_cast<int>(stats.nonlinearIterations - previousIterations),
+                         static_cast<int>(stats.errorTestFailures - previousErrorTestFailures)))
+      break;
     previousIterations = stats.nonlinearIterations;
     previousErrorTestFailures = stats.errorTestFailures;
   }

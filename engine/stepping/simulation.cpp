@@ -1,6 +1,8 @@
 #include "engine/stepping/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace mpx {
 
@@ -21,8 +23,57 @@ RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink,
   sink_(record_);
 }
 
-void RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks) {
+namespace {
+
+bool finite(const Measures& m) {
+  return std::isfinite(m.energy) && std::isfinite(m.entropy) && m.momentum.allFinite() && m.angularMomentum.allFinite();
+}
+
+bool finite(const Flows& f) {
+  return std::isfinite(f.dissipated) && std::isfinite(f.externalWork) && std::isfinite(f.boundaryHeat) &&
+         std::isfinite(f.boundaryEntropy);
+}
+
+// Which dof of `z`, or which component's measures, or which flow is not finite (a state the
+// residual accepted can still give a NaN energy, e.g. a logarithm of a quantity gone negative).
+std::string describeNonFinite(const Model& model, const Eigen::VectorXd& z, const Measures& measures,
+                              const Flows& crossed) {
+  for (Eigen::Index dof = 0; dof < z.size(); ++dof) {
+    if (std::isfinite(z[dof])) continue;
+    std::string owner;
+    for (const auto& component : model.components())
+      if (std::find(component->dofs().begin(), component->dofs().end(), dof) != component->dofs().end()) {
+        owner = " of " + component->name();
+        break;
+      }
+    return "the state at dof " + std::to_string(dof) + " (" +
+           std::string(blockName(model.layout().blockOf(static_cast<int>(dof)))) + owner + ") is not finite";
+  }
+  if (!finite(measures))
+    for (const auto& component : model.components()) {
+      Measures own;
+      own.nodeTemperature.assign(measures.nodeTemperature.size(), 0.0);
+      component->measure(z.data(), own);
+      if (!finite(own))
+        return "the energy, entropy or momentum measured by " + component->name() +
+               " is not finite (E = " + std::to_string(own.energy) + ", S = " + std::to_string(own.entropy) + ")";
+    }
+  if (!finite(crossed)) return "the dissipated energy, external work or boundary heat is not finite";
+  return "the measures of the state are not finite";
+}
+
+}  // namespace
+
+bool RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks) {
   model_.measure(state_, measures_);
+  // a non-finite state or output ends the run here, before it reaches the history
+  if (!state_.allFinite() || !finite(measures_) || !finite(crossed)) {
+    summary_.failed = true;
+    summary_.failedStep = step;
+    summary_.failedTime = time - dt;
+    summary_.failure = describeNonFinite(model_, state_, measures_, crossed);
+    return false;
+  }
   record_.step = step;
   record_.time = time;
   record_.dt = dt;
@@ -44,6 +95,7 @@ void RunReporter::report(int step, double time, double dt, const Flows& crossed,
     progress_(std::min(1.0, time / tEnd_));
     nextProgress_ = time + 0.01 * tEnd_;
   }
+  return true;
 }
 
 void RunReporter::finish() {
@@ -75,7 +127,8 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     }
     reporter.state().swap(next);
     crossed += outcome.energy;
-    reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks);
+    if (!reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks))
+      break;
   }
   reporter.finish();
   return summary;

@@ -101,8 +101,9 @@ class RunReporter {
   Eigen::VectorXd& state() { return state_; }
   const StepRecord& last() const { return record_; }
   // Report state() as `step` at `time`, reached by a step of `dt`; `crossed` holds the
-  // energies crossed since t = 0.
-  void report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
+  // energies crossed since t = 0. False, with the failure in the summary and nothing handed
+  // to the sink, when the state, its measures or the flows are not finite: the run stops.
+  bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();
 
