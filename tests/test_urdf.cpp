@@ -335,7 +335,7 @@ const std::vector<BadUrdf> kBadUrdfs = {
      robotWith({kWorld, kArm, linkWith("a", "1", kBox), linkWith("b", "1", kBox), kHinge,
                 jointWith("ab", "continuous", "a", "b"), jointWith("ba", "continuous", "b", "a")}),
      4,
-     {"<link name=\"a\">", "not connected to the root link 'world'"}},
+     {"<link name=\"a\">", "on a cycle of joints", "'ba'"}},
     {"LinkWithTwoParents",
      robotWith({kWorld, kArm, linkWith("b", "1", kBox), kHinge, jointWith("world_b", "continuous", "world", "b"),
                 jointWith("arm_b", "continuous", "arm", "b")}),

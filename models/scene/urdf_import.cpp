@@ -84,6 +84,7 @@ class UrdfFile {
     const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_, TextContent::Allowed);
     for (const tinyxml2::XMLElement* e = robot.FirstChildElement(); e; e = e->NextSiblingElement())
       if (const char* name = e->Attribute("name")) lines_.emplace(key(e->Name(), name), e->GetLineNum());
+    checkJointTree(robot);
   }
 
   const std::string& path() const { return path_; }
@@ -104,6 +105,42 @@ class UrdfFile {
 
  private:
   static std::string key(const std::string& kind, const std::string& name) { return kind + " " + name; }
+
+  // The joints must form a tree before urdfdom sees them: it links parents and children by
+  // shared_ptr, and links on a cycle would own each other and never be freed (the fuzzer found
+  // a joint from a link to itself).
+  void checkJointTree(const tinyxml2::XMLElement& robot) const {
+    std::map<std::string, std::string> parentOf, jointTo;  // per child link: its parent link, its joint
+    for (const tinyxml2::XMLElement* e = robot.FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
+      const tinyxml2::XMLElement* parentElement = e->FirstChildElement("parent");
+      const tinyxml2::XMLElement* childElement = e->FirstChildElement("child");
+      const char* name = e->Attribute("name");
+      const char* parent = parentElement ? parentElement->Attribute("link") : nullptr;
+      const char* child = childElement ? childElement->Attribute("link") : nullptr;
+      if (!name || !parent || !child) continue;  // urdfdom names what is missing
+      if (std::string(parent) == child)
+        fail("joint", name, "has link '" + std::string(child) + "' as both parent and child: a URDF must be a tree");
+      const auto [reached, first] = jointTo.emplace(child, name);
+      if (!first)
+        fail("link", child,
+             "is the child of two joints, '" + reached->second + "' and '" + name + "': a URDF must be a tree");
+      parentOf[child] = parent;
+    }
+    // follow each link's parents up to a root; a walk that meets itself is a cycle
+    enum Mark { Unseen, OnWalk, LeadsToRoot };
+    std::map<std::string, Mark> marks;
+    for (const auto& [start, parent] : parentOf) {
+      std::vector<std::string> walk;
+      std::string link = start;
+      for (; marks[link] == Unseen && parentOf.count(link); link = parentOf.at(link)) {
+        marks[link] = OnWalk;
+        walk.push_back(link);
+      }
+      if (marks[link] == OnWalk)
+        fail("link", link, "is on a cycle of joints (one is '" + jointTo.at(link) + "'): a URDF must be a tree");
+      for (const std::string& reached : walk) marks[reached] = LeadsToRoot;
+    }
+  }
 
   std::string path_, text_;
   std::map<std::string, int> lines_;
@@ -181,7 +218,6 @@ class UrdfTranslator {
   const urdf::ModelInterface& robot_;
   const UrdfImportOptions& options_;
   SceneSpec& scene_;
-  std::map<std::string, std::string> parentJoint_;  // reached link -> joint it was reached through
   std::vector<std::string> limitedJoints_, ignoredDynamics_;
 };
 
@@ -191,12 +227,7 @@ void UrdfTranslator::translate() {
   LinkState state;
   state.frame = Eigen::Translation3d(options_.position) * options_.orientation;
   state.carrier = addRoot(root, state);
-  parentJoint_[root.name] = "";
   addDescendants(root, state);
-  // urdfdom accepts links that a cycle of joints keeps away from the root
-  for (const auto& [name, link] : robot_.links_)
-    if (!parentJoint_.count(name))
-      file_.fail("link", name, "is not connected to the root link '" + root.name + "' (a cycle of joints?)");
   reportIgnored();
 }
 
@@ -256,10 +287,6 @@ void UrdfTranslator::addDescendants(const urdf::Link& root, const LinkState& roo
 }
 
 LinkState UrdfTranslator::addChild(const urdf::Joint& joint, const urdf::Link& child, const LinkState& parentState) {
-  const auto [reached, first] = parentJoint_.emplace(child.name, joint.name);
-  if (!first)
-    file_.fail("link", child.name,
-               "is the child of two joints, '" + reached->second + "' and '" + joint.name + "': a URDF must be a tree");
   if (joint.mimic)
     file_.fail("joint", joint.name,
                "mimics joint '" + joint.mimic->joint_name +
