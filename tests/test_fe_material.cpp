@@ -252,7 +252,7 @@ TEST_P(GonzalezStress, IncrementIsTheDerivativeInTheEndPoint) {
     const auto [C0, C1] = strainPair(random, c.amplitude);
     ASSERT_EQ((C1 - C0).norm() <= kStressQuotientSwitch * std::max(C0.norm(), C1.norm()), c.belowSwitch);
     const Mat3 H = random.symmetric();
-    const auto stressAt = [&](const Mat3& end) { return DiscreteStress(*material, C0, end).stress(); };
+    const auto stressAt = [&, start = C0](const Mat3& end) { return DiscreteStress(*material, start, end).stress(); };
     const Mat3 fd = directionalDifference(stressAt, C1, H, c.step);
     const Mat3 exact = DiscreteStress(*material, C0, C1).increment(H);
     EXPECT_LT(relativeError(fd, exact), 1e-6) << "amplitude " << c.amplitude << ", |dC| " << (C1 - C0).norm();

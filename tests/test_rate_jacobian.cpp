@@ -38,11 +38,12 @@ TEST_P(RateJacobian, MatchesCentralDifferences) {
     assembler.addRate(model, workspace, {z.data(), zdot.data(), 0.1, alpha, beta}, 1.0);
     assembler.imposeRateMotions(model, z.data(), zdot.data(), 0.1, beta);
     const MatrixXd analytic = MatrixXd(assembler.tangent());
-    const VectorXd at = alpha > 0 ? z : zdot;
+    const bool byState = alpha > 0;  // a named copy: lambdas capture no structured binding (C++17)
+    const VectorXd at = byState ? z : zdot;
     const MatrixXd numeric =
-        centralDifferences([&](const VectorXd& x) { return alpha > 0 ? residual(x, zdot) : residual(z, x); }, at,
-                           magnitudeAt(model, at), alpha > 0 ? 1e-6 : kRateStep);
-    SCOPED_TRACE(alpha > 0 ? "dF/dz" : "dF/dzdot");
+        centralDifferences([&](const VectorXd& x) { return byState ? residual(x, zdot) : residual(z, x); }, at,
+                           magnitudeAt(model, at), byState ? 1e-6 : kRateStep);
+    SCOPED_TRACE(byState ? "dF/dz" : "dF/dzdot");
     expectTangentMatches(model, analytic, numeric, magnitudeAt(model, at), 1e-5);
   }
 }

@@ -118,7 +118,9 @@ std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeomet
   if (sides_[0].kind == Attachment::Kind::Ground && sides_[1].kind == Attachment::Kind::Ground)
     throw std::invalid_argument("a joint needs at least one side that moves");
   std::vector<QuadraticForm> forms;
-  const auto [n1, n2] = perpendiculars(g.axis);
+  // named copies, not structured bindings: lambdas capture them (C++17)
+  const std::pair<Vec3, Vec3> normals = perpendiculars(g.axis);
+  const Vec3 &n1 = normals.first, &n2 = normals.second;
   const AffineVector gap = difference(point(0, g.anchor), point(1, g.anchor));
   auto coincide = [&] {
     for (int k = 0; k < 3; ++k) forms.push_back(component(gap, k));
