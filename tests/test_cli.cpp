@@ -94,10 +94,11 @@ class CliTest : public ::testing::Test {
   }
   fs::path outDir() const { return dir_ / "out"; }
 
-  // Run `metriplex arguments` with stdout and stderr captured to files.
-  Invocation metriplex(const std::string& arguments) const {
+  // Run `launcher metriplex arguments` with stdout and stderr captured to files.
+  Invocation metriplex(const std::string& arguments, const std::string& launcher = "") const {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
+    const std::string command =
+        launcher + quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
     const int status = std::system(command.c_str());
     Invocation result;
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -406,6 +407,35 @@ TEST_F(CliTest, InvertingACellIsASolverFailure) {
   // the failure names the cell whose residual went non-finite and the dof
   EXPECT_NE(r.err.find("the residual of bar.cell0 at dof 0 (position) was not finite"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(outDir() / "history.csv"));
+}
+
+// SIGINT (run) and SIGTERM (compare) stop at a step boundary with exit code 4: the history is
+// complete up to that step (no .part file) and says where and why it ends; a comparison starts
+// no further integrator.
+TEST_F(CliTest, ASignalStopsAtAStepBoundaryWithAMarkedHistory) {
+  const std::string longRun = quoted(fs::path(mpx::test::scenePath("two_thermo_springs.xml"))) + " --t-end 1e7";
+  const Invocation run =
+      metriplex("run " + longRun + " --out " + quoted(outDir()), "timeout --preserve-status -s INT 1 ");
+  EXPECT_EQ(run.exitCode, 4) << run.err;
+  EXPECT_NE(run.err.find("interrupted after step"), std::string::npos) << run.err;
+  ASSERT_TRUE(fs::exists(outDir() / "history.csv"));
+  EXPECT_FALSE(fs::exists(outDir() / "history.csv.part"));
+  std::istringstream history(readFile(outDir() / "history.csv"));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(history, line);) lines.push_back(line);
+  ASSERT_GE(lines.size(), 3u);
+  const std::size_t rows = lines.size() - 2;  // the header and the marker
+  EXPECT_EQ(lines.back().rfind("# interrupted after step " + std::to_string(rows - 1) + " (t = ", 0), 0u)
+      << lines.back();
+  const auto columns = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
+  EXPECT_EQ(columns(lines[lines.size() - 2]), columns(lines[0])) << "the last row is complete";
+
+  const Invocation compare = metriplex("compare " + longRun + " --integrators eem,midpoint --out " + quoted(outDir()),
+                                       "timeout --preserve-status -s TERM 1 ");
+  EXPECT_EQ(compare.exitCode, 4) << compare.err;
+  EXPECT_NE(compare.out.find("interrupted after step"), std::string::npos) << compare.out;
+  EXPECT_TRUE(fs::exists(outDir() / "eem" / "history.csv"));
+  EXPECT_FALSE(fs::exists(outDir() / "midpoint")) << "an integrator was started after the interruption";
 }
 
 // A misspelt subcommand is named; an output directory that cannot be made names --out

@@ -104,6 +104,7 @@ BenchRun measure(const Model& model, const Method& method, const MethodParameter
       lastState = *record.state;
       if (std::isnan(loadEndEnergy) && record.time >= loadEndTime - 1e-9 * parameters.tEnd) loadEndEnergy = m.energy;
     });
+    if (run.summary.interrupted) throw RunInterrupted();
     cpu.push_back(static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC);
     run.final = finalStateOf(model, lastState, last);
     run.final.loadEndEnergy = loadEndEnergy;

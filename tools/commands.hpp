@@ -1,6 +1,7 @@
 #pragma once
 // The metriplex subcommands. Each validates all of its input before it writes anything and
 // returns the process exit code; invalid input throws InputError (exit code 2).
+#include <exception>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,12 @@ namespace mpx {
 
 inline constexpr int kExitInvalidInput = 2;
 inline constexpr int kExitSolverFailure = 3;
+inline constexpr int kExitInterrupted = 4;  // SIGINT or SIGTERM: stopped at a step boundary
+
+// A run stopped by SIGINT or SIGTERM where the command cannot report it itself (bench).
+struct RunInterrupted : std::exception {
+  const char* what() const noexcept override { return "interrupted (SIGINT or SIGTERM)"; }
+};
 
 struct RunRequest {
   std::string scene;

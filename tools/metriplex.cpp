@@ -3,10 +3,12 @@
 #include "tools/commands.hpp"
 
 #include "engine/core/input_error.hpp"
+#include "engine/stepping/simulation.hpp"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <filesystem>
 #include <sstream>
 
@@ -50,7 +52,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Metriplex: flexible multibody dynamics with dissipation, integrated with "
       "Energy-Entropy-Momentum (EEM) and standard methods.\n"
-      "Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure."};
+      "Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure, 4 interrupted by SIGINT or SIGTERM "
+      "(stopped at a step boundary, history kept)."};
   app.require_subcommand(1);
 
   RunRequest request;
@@ -108,6 +111,8 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitInvalidInput;
   }
+  // SIGINT and SIGTERM stop a run at its next step boundary, with its history well formed
+  for (const int signal : {SIGINT, SIGTERM}) std::signal(signal, [](int) { requestStop(); });
   try {
     if (run->parsed()) return runCommand(request);
     if (compare->parsed()) return compareCommand(request, splitNames(integrators));
@@ -119,6 +124,9 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     fmt::print(stderr, "metriplex: {}\n", e.what());
     return kExitInvalidInput;
+  } catch (const RunInterrupted& e) {
+    fmt::print(stderr, "metriplex: {}\n", e.what());
+    return kExitInterrupted;
   } catch (const std::filesystem::filesystem_error& e) {
     fmt::print(stderr, "metriplex: {}\n", e.what());
     return kExitInvalidInput;

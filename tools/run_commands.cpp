@@ -155,6 +155,11 @@ int runCommand(const RunRequest& request) {
   const PreparedRun run = prepare(request, "");
   const RunResult result = execute(run);
   printSummary(result, request, run);
+  if (result.summary.interrupted) {
+    fmt::print(stderr, "metriplex: interrupted after step {} (t = {:.9g}); history kept in {}\n", result.summary.steps,
+               result.summary.interruptedTime, result.history.string());
+    return kExitInterrupted;
+  }
   if (!result.summary.failed) return 0;
   fmt::print(stderr,
              "metriplex: solver failure at step {} (t = {:.9g}): {}; history kept up to the last good step in {}\n",
@@ -181,10 +186,14 @@ int compareCommand(const RunRequest& base, const std::vector<std::string>& integ
     const RunResult r = execute(run);
     const RunSummary& s = r.summary;
     const std::string status =
-        s.failed ? fmt::format("failed at step {} (t = {:.6g}): {}", s.failedStep, s.failedTime, s.failure) : "ok";
+        s.interrupted ? fmt::format("interrupted after step {} (t = {:.6g})", s.steps, s.interruptedTime)
+        : s.failed    ? fmt::format("failed at step {} (t = {:.6g}): {}", s.failedStep, s.failedTime, s.failure)
+                      : "ok";
     fmt::print("{:<16} {:>8} {:>12.2f} {:>10.3f} {:>16.3e} {:>16.3e}  {}\n", run.method.name, s.steps,
                perStep(s.newtonIterations, s.steps), s.wallSeconds, s.maxEnergyBalanceError, s.minEntropyProduction,
                status);
+    // an interruption stops the comparison: the integrators after it are not started
+    if (s.interrupted) return kExitInterrupted;
   }
   fmt::print("histories in {}/<integrator>/history.csv\n", root.string());
   return 0;

@@ -1,6 +1,7 @@
 #include "engine/stepping/simulation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -24,6 +25,10 @@ RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink,
 }
 
 namespace {
+
+// lock-free, so a signal handler may set it
+std::atomic<bool> stopRequest{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
 
 bool finite(const Measures& m) {
   return std::isfinite(m.energy) && std::isfinite(m.entropy) && m.momentum.allFinite() && m.angularMomentum.allFinite();
@@ -64,6 +69,9 @@ std::string describeNonFinite(const Model& model, const Eigen::VectorXd& z, cons
 
 }  // namespace
 
+void requestStop() noexcept { stopRequest = true; }
+bool stopRequested() noexcept { return stopRequest; }
+
 bool RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks) {
   model_.measure(state_, measures_);
   // a non-finite state or output ends the run here, before it reaches the history
@@ -95,7 +103,10 @@ bool RunReporter::report(int step, double time, double dt, const Flows& crossed,
     progress_(std::min(1.0, time / tEnd_));
     nextProgress_ = time + 0.01 * tEnd_;
   }
-  return true;
+  if (!stopRequested()) return true;
+  summary_.interrupted = true;
+  summary_.interruptedTime = time;
+  return false;
 }
 
 void RunReporter::finish() {

@@ -84,7 +84,15 @@ struct RunSummary {
   int failedStep = 0;
   double failedTime = 0.0;
   std::string failure;
+  bool interrupted = false;  // stopped by requestStop() after `steps` steps, at interruptedTime
+  double interruptedTime = 0.0;
 };
+
+// A stop asked for from outside the run (the CLI's SIGINT and SIGTERM handlers): every time loop
+// ends at its next step boundary, after that step is reported, with the summary marked
+// interrupted. Safe to call from a signal handler; a request holds for the rest of the process.
+void requestStop() noexcept;
+bool stopRequested() noexcept;
 
 using StepSink = std::function<void(const StepRecord&)>;
 // Called with the fraction of the run done, at most about a hundred times.
@@ -101,8 +109,9 @@ class RunReporter {
   Eigen::VectorXd& state() { return state_; }
   const StepRecord& last() const { return record_; }
   // Report state() as `step` at `time`, reached by a step of `dt`; `crossed` holds the
-  // energies crossed since t = 0. False, with the failure in the summary and nothing handed
-  // to the sink, when the state, its measures or the flows are not finite: the run stops.
+  // energies crossed since t = 0. False when the run must stop: the state, its measures or the
+  // flows are not finite (a failure in the summary, nothing handed to the sink), or a stop was
+  // requested (the step reported, the summary marked interrupted).
   bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();

@@ -59,6 +59,9 @@ void HistoryCsv::finish(const RunSummary& summary) {
   if (summary.failed)
     fmt::print(file_, "# solver failure at step {} (t = {:.17g}): {}; rows above are the last good steps\n",
                summary.failedStep, summary.failedTime, summary.failure);
+  if (summary.interrupted)
+    fmt::print(file_, "# interrupted after step {} (t = {:.17g}) by a stop request (SIGINT or SIGTERM)\n",
+               summary.steps, summary.interruptedTime);
   std::fclose(file_);
   file_ = nullptr;
   std::filesystem::rename(partPath_, finalPath_);
