@@ -414,8 +414,12 @@ TEST_F(CliTest, InvertingACellIsASolverFailure) {
 // no further integrator.
 TEST_F(CliTest, ASignalStopsAtAStepBoundaryWithAMarkedHistory) {
   const std::string longRun = quoted(fs::path(mpx::test::scenePath("two_thermo_springs.xml"))) + " --t-end 1e7";
-  const Invocation run =
-      metriplex("run " + longRun + " --out " + quoted(outDir()), "timeout --preserve-status -s INT 1 ");
+  // the signal goes once the run has begun writing its history, however slow the machine
+  const auto signalOnceRunning = [](const char* signal, const fs::path& history) {
+    return "sh -c 'while [ ! -s " + history.string() + " ]; do sleep 0.05; done; kill -" + signal + " $PPID' & exec ";
+  };
+  const Invocation run = metriplex("run " + longRun + " --out " + quoted(outDir()),
+                                   signalOnceRunning("INT", outDir() / "history.csv.part"));
   EXPECT_EQ(run.exitCode, 4) << run.err;
   EXPECT_NE(run.err.find("interrupted after step"), std::string::npos) << run.err;
   ASSERT_TRUE(fs::exists(outDir() / "history.csv"));
@@ -431,7 +435,7 @@ TEST_F(CliTest, ASignalStopsAtAStepBoundaryWithAMarkedHistory) {
   EXPECT_EQ(columns(lines[lines.size() - 2]), columns(lines[0])) << "the last row is complete";
 
   const Invocation compare = metriplex("compare " + longRun + " --integrators eem,midpoint --out " + quoted(outDir()),
-                                       "timeout --preserve-status -s TERM 1 ");
+                                       signalOnceRunning("TERM", outDir() / "eem" / "history.csv.part"));
   EXPECT_EQ(compare.exitCode, 4) << compare.err;
   EXPECT_NE(compare.out.find("interrupted after step"), std::string::npos) << compare.out;
   EXPECT_TRUE(fs::exists(outDir() / "eem" / "history.csv"));

@@ -1,6 +1,8 @@
 // The malformed-input corpus (tests/malformed/cases.txt): scenes, URDFs, Gmsh meshes and
 // command lines that must each be refused with exit code 2, a message holding the expected
 // fragment (for files: the file name and line) and no output directory created.
+#include "support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -53,13 +55,6 @@ std::string replaced(std::string text, const std::string& placeholder, const std
   return text;
 }
 
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
 TEST(MalformedInputs, EachIsRefusedWithItsMessageAndWritesNothing) {
   std::string pattern = (fs::temp_directory_path() / "metriplex-malformed-XXXXXX").string();
   ASSERT_NE(mkdtemp(pattern.data()), nullptr);
@@ -74,7 +69,7 @@ TEST(MalformedInputs, EachIsRefusedWithItsMessageAndWritesNothing) {
     const int status = std::system(command.c_str());
     ASSERT_TRUE(WIFEXITED(status)) << "the program did not exit normally (a crash?)";
     EXPECT_EQ(WEXITSTATUS(status), c.exitCode);
-    const std::string message = readFile(err);
+    const std::string message = mpx::test::readFile(err.string());
     EXPECT_NE(message.find(c.fragment), std::string::npos) << "stderr: " << message;
     if (c.exitCode == 2) {
       EXPECT_FALSE(fs::exists(out)) << "an invalid input wrote " << out;

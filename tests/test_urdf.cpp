@@ -527,6 +527,21 @@ TEST_F(UrdfTest, ChainOfThirtyThousandLinksImportsParentsFirst) {
   }
 }
 
+// A branching tree is walked depth first: a link's whole subtree before its next sibling (world's
+// joints j1 -> a and j2 -> b in name order, a's joint j3 -> c), as the recursive walk did.
+TEST_F(UrdfTest, BranchesImportDepthFirst) {
+  const SceneSpec scene =
+      readUrdfScene(write("tree.urdf", robotWith({kWorld, linkWith("a", "1", kBox), linkWith("b", "1", kBox),
+                                                  linkWith("c", "1", kBox), jointWith("j1", "continuous", "world", "a"),
+                                                  jointWith("j2", "continuous", "world", "b"),
+                                                  jointWith("j3", "continuous", "a", "c")}))
+                        .string());
+  std::vector<std::string> bodies;
+  for (const ElementSpec& element : scene.elements)
+    if (element.tag == "body") bodies.push_back(*element.find("name"));
+  EXPECT_EQ(bodies, (std::vector<std::string>{"a", "c", "b"}));
+}
+
 // (with the text of <gazebo> and <transmission> elements, which the importer ignores)
 TEST_F(UrdfTest, UrdfFileRunsAsASceneWithDefaults) {
   const fs::path urdf =

@@ -16,6 +16,11 @@ namespace {
 
 using namespace mpx;
 
+extern "C" void stopAtNextStep(int signal) {
+  requestStop();
+  std::signal(signal, SIG_DFL);
+}
+
 std::vector<std::string> splitNames(const std::string& list) {
   std::vector<std::string> names;
   std::stringstream stream(list);
@@ -111,8 +116,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitInvalidInput;
   }
-  // SIGINT and SIGTERM stop a run at its next step boundary, with its history well formed
-  for (const int signal : {SIGINT, SIGTERM}) std::signal(signal, [](int) { requestStop(); });
+  // SIGINT and SIGTERM stop a run at its next step boundary, with its history well formed; a
+  // second one (while a scene loads, say) ends the program at once
+  for (const int signal : {SIGINT, SIGTERM}) std::signal(signal, stopAtNextStep);
   try {
     if (run->parsed()) return runCommand(request);
     if (compare->parsed()) return compareCommand(request, splitNames(integrators));

@@ -1,7 +1,5 @@
 #include "engine/linear/condensed_solver.hpp"
 
-#include "engine/linear/sparse_entry.hpp"
-
 #include <algorithm>
 
 namespace mpx {

@@ -30,8 +30,11 @@ namespace {
 std::atomic<bool> stopRequest{false};
 static_assert(std::atomic<bool>::is_always_lock_free);
 
+// every measure the history writes
 bool finite(const Measures& m) {
-  return std::isfinite(m.energy) && std::isfinite(m.entropy) && m.momentum.allFinite() && m.angularMomentum.allFinite();
+  return std::isfinite(m.energy) && std::isfinite(m.entropy) && std::isfinite(m.constraintViolation) &&
+         m.momentum.allFinite() && m.angularMomentum.allFinite() &&
+         std::all_of(m.nodeTemperature.begin(), m.nodeTemperature.end(), [](double t) { return std::isfinite(t); });
 }
 
 bool finite(const Flows& f) {
@@ -60,7 +63,7 @@ std::string describeNonFinite(const Model& model, const Eigen::VectorXd& z, cons
       own.nodeTemperature.assign(measures.nodeTemperature.size(), 0.0);
       component->measure(z.data(), own);
       if (!finite(own))
-        return "the energy, entropy or momentum measured by " + component->name() +
+        return "the energy, entropy, momentum or a temperature measured by " + component->name() +
                " is not finite (E = " + std::to_string(own.energy) + ", S = " + std::to_string(own.entropy) + ")";
     }
   if (!finite(crossed)) return "the dissipated energy, external work or boundary heat is not finite";
@@ -78,7 +81,7 @@ bool RunReporter::report(int step, double time, double dt, const Flows& crossed,
   if (!state_.allFinite() || !finite(measures_) || !finite(crossed)) {
     summary_.failed = true;
     summary_.failedStep = step;
-    summary_.failedTime = time - dt;
+    summary_.failedTime = record_.time;  // the last good record's: where the failing step (IDA: interval) began
     summary_.failure = describeNonFinite(model_, state_, measures_, crossed);
     return false;
   }
@@ -103,7 +106,7 @@ bool RunReporter::report(int step, double time, double dt, const Flows& crossed,
     progress_(std::min(1.0, time / tEnd_));
     nextProgress_ = time + 0.01 * tEnd_;
   }
-  if (!stopRequested()) return true;
+  if (!stopRequested() || time >= tEnd_) return true;
   summary_.interrupted = true;
   summary_.interruptedTime = time;
   return false;

@@ -89,7 +89,7 @@ struct RunSummary {
 };
 
 // A stop asked for from outside the run (the CLI's SIGINT and SIGTERM handlers): every time loop
-// ends at its next step boundary, after that step is reported, with the summary marked
+// ends after its next reported step (IDA: its next output time), with the summary marked
 // interrupted. Safe to call from a signal handler; a request holds for the rest of the process.
 void requestStop() noexcept;
 bool stopRequested() noexcept;
@@ -110,8 +110,9 @@ class RunReporter {
   const StepRecord& last() const { return record_; }
   // Report state() as `step` at `time`, reached by a step of `dt`; `crossed` holds the
   // energies crossed since t = 0. False when the run must stop: the state, its measures or the
-  // flows are not finite (a failure in the summary, nothing handed to the sink), or a stop was
-  // requested (the step reported, the summary marked interrupted).
+  // flows are not finite (a failure in the summary, nothing handed to the sink; state() then
+  // holds the rejected state), or a stop was requested before tEnd (the step reported, the
+  // summary marked interrupted).
   bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();

@@ -24,12 +24,7 @@ class XmlTextCheck {
     for (; i_ < text_.size(); ++i_) {
       const char c = text_[i_];
       if (c == '\n') ++line_;
-      // XML 1.0 allows no control characters but tab, newline and carriage return
-      if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r') {
-        char code[8];
-        std::snprintf(code, sizeof code, "0x%02X", static_cast<unsigned>(c));
-        fail(std::string("control character ") + code + " is not allowed in XML (is this a binary file?)");
-      }
+      checkCharacter(c);
       if (state == State::Text) {
         if (startsWith("<!--")) {
           skipPast("<!--", "-->");
@@ -68,9 +63,20 @@ class XmlTextCheck {
     const std::size_t end = text_.find(terminator, i_ + std::char_traits<char>::length(opener));
     const std::size_t stop =
         end == std::string::npos ? text_.size() : end + std::char_traits<char>::length(terminator) - 1;
-    for (std::size_t k = i_ + 1; k < stop && k < text_.size(); ++k)
+    for (std::size_t k = i_ + 1; k < stop && k < text_.size(); ++k) {
       if (text_[k] == '\n') ++line_;
+      checkCharacter(text_[k]);
+    }
     i_ = stop;
+  }
+
+  // XML 1.0 allows no control characters but tab, newline and carriage return, not even in
+  // comments (tinyxml2 would stop reading at a NUL)
+  void checkCharacter(char c) const {
+    if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n' || c == '\r') return;
+    char code[8];
+    std::snprintf(code, sizeof code, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+    fail(std::string("control character ") + code + " is not allowed in XML (is this a binary file?)");
   }
 
   // The reference starting at i_: a predefined entity or a character reference to a valid XML
