@@ -139,6 +139,9 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
     fmt::print("  cut-backs                {}\n", s.cutbacks);
   }
   fmt::print("  linear system            {}\n", s.linearSystem);
+  if (!run.scene.redundantConditions.empty())
+    fmt::print("  redundant conditions     {} (multipliers held at zero)\n",
+               describeRedundancy(run.scene.redundantConditions));
   fmt::print("  wall time                {:.3f} s\n", s.wallSeconds);
   fmt::print(
       "  max rel. energy drift    {:.3e}  (max |E + dissipated - external work - boundary heat - E0| / largest energy "

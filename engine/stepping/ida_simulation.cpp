@@ -245,16 +245,23 @@ bool IdaProblem::initialise(double firstOutput) {
   for (int col = 0; col < n; ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
       if (it.value() != 0.0) hasRate[it.row()] = true;
+  // a row without rates that sees only multipliers states their values (a redundant
+  // condition's lambda = 0): it is solved as it stands, not differentiated
+  std::vector<bool> seesState(n, false);
+  for (int col = 0; col < n; ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(dFdz, col); it; ++it)
+      if (it.value() != 0.0 && !algebraic(col)) seesState[it.row()] = true;
   for (int col = 0; col < n; ++col) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(dFdz, col); it; ++it) {
       if (!hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());  // dF_a/dz . zdot
-      if (hasRate[it.row()] && algebraic(col)) entries.emplace_back(it.row(), col, it.value());    // multipliers
+      if ((hasRate[it.row()] || !seesState[it.row()]) && algebraic(col))
+        entries.emplace_back(it.row(), col, it.value());  // multipliers
     }
     for (Eigen::SparseMatrix<double>::InnerIterator it(dFdzdot, col); it; ++it)
       if (hasRate[it.row()] && !algebraic(col)) entries.emplace_back(it.row(), col, it.value());
   }
   for (int i = 0; i < n; ++i)
-    if (!hasRate[i]) rhs[i] = 0.0;
+    if (!hasRate[i] && seesState[i]) rhs[i] = 0.0;
   Eigen::SparseMatrix<double> system(n, n);
   system.setFromTriplets(entries.begin(), entries.end());
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(system);

@@ -51,10 +51,15 @@ int constraintCount(JointType type) {
   return 0;
 }
 
-JointBuilder::JointBuilder(const Attachment& a, const Attachment& b) : sides_{a, b} {
+JointBuilder::JointBuilder(const Attachment& a, const Attachment& b)
+    : sides_{a, b}, ends_{a.firstPositionDof, b.firstPositionDof} {
   offset_[1] = dofCount(a);
   for (const Attachment& side : sides_)
     for (int i = 0; i < dofCount(side); ++i) dofs_.push_back(side.firstPositionDof + i);
+}
+
+JointBuilder::JointBuilder(const Attachment& body) : JointBuilder(body, Attachment{}) {
+  ends_.second = body.firstPositionDof;
 }
 
 AffineVector JointBuilder::point(int side, const Vec3& worldPoint) const {

@@ -47,12 +47,18 @@ struct JointGeometry {
 class JointBuilder {
  public:
   JointBuilder(const Attachment& a, const Attachment& b);
+  // The rigidity of one body: a constraint within it, not between two things.
+  explicit JointBuilder(const Attachment& body);
+
+  // What the forms join: the first position dof of each side (-1: the ground), the same dof
+  // twice for a body's rigidity.
+  std::pair<int, int> ends() const { return ends_; }
 
   // The position dofs q of the forms, a's then b's.
   const std::vector<int>& positionDofs() const { return dofs_; }
   // Forms of a joint; throws std::invalid_argument when the attachments cannot carry it.
   std::vector<QuadraticForm> joint(JointType type, const JointGeometry& geometry) const;
-  // d_i . d_j - delta_ij of a single body (b is ignored).
+  // d_i . d_j - delta_ij of a single body (the one-body builder).
   std::vector<QuadraticForm> rigidity() const;
   // Quadratic invariants that give a joint's coordinate: revolute (u, v) = (a1.b1, a2.b1) with
   // a1, a2 perpendicular to the axis on a and b1 on b (angle atan2(v, u), 0 at t = 0);
@@ -70,6 +76,7 @@ class JointBuilder {
   Attachment sides_[2];
   int offset_[2] = {0, 0};  // first local q index of each side
   std::vector<int> dofs_;
+  std::pair<int, int> ends_;
 };
 
 }  // namespace mpx

@@ -17,7 +17,8 @@ std::vector<int> QuadraticConstraint::collectDofs(const ConstraintSpec& spec) {
 QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
     : Component(spec.name, collectDofs(spec)),
       spec_(std::move(spec)),
-      positionCount_(static_cast<int>(spec_.positionDofs.size())) {}
+      positionCount_(static_cast<int>(spec_.positionDofs.size())),
+      implied_(spec_.forms.size(), false) {}
 
 ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
   ConstraintVector q(positionCount_);
@@ -53,13 +54,19 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
     K.block(n, 0, n, n) +=
         0.5 * force * form.hessian + (0.5 * spec_.stiffness) * gradientMid * form.gradientAt(q1).transpose();
     if (!augmented()) continue;
-    // lambda's row: the constraint at the end of the step; mu is not used by EEM (mu = 0)
+    // mu is not used by EEM (mu = 0), nor lambda of an implied form
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
+    r[mu] = args.zNew[spec_.firstMultiplierDof + m + k];
+    K(mu, mu) = 1.0;
+    if (implied_[k]) {
+      r[lambda] = args.zNew[spec_.firstMultiplierDof + k];
+      K(lambda, lambda) = 1.0;
+      continue;
+    }
+    // lambda's row: the constraint at the end of the step
     K.block(n, lambda, n, 1) += gradientMid;
     r[lambda] = form.value(q1);
     K.block(lambda, 0, 1, n) = form.gradientAt(q1).transpose();
-    r[mu] = args.zNew[spec_.firstMultiplierDof + m + k];
-    K(mu, mu) = 1.0;
   }
 }
 
@@ -78,6 +85,14 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     // GGL (index 2): M v' + (lambda + kappa Phi) G^T = f, q' - v + mu G^T = 0, Phi = 0, G v = 0
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
     const double muValue = args.z[spec_.firstMultiplierDof + m + k];
+    // an implied form's multipliers are held at zero: lambda = mu = 0
+    if (implied_[k]) {
+      r[lambda] = args.z[spec_.firstMultiplierDof + k];
+      K(lambda, lambda) = args.alpha;
+      r[mu] = muValue;
+      K(mu, mu) = args.alpha;
+      continue;
+    }
     K.block(n, lambda, n, 1) += args.alpha * gradient;
     r.head(n) += muValue * gradient;
     K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;

@@ -53,6 +53,14 @@ class QuadraticConstraint final : public Component {
     const int mus = 2 * positionCount_ + static_cast<int>(spec_.forms.size());
     return row >= positionCount_ || column < positionCount_ || column >= mus;
   }
+  const ConstraintSpec& spec() const { return spec_; }
+  // Form k is implied by other forms (a redundant condition, e.g. the out-of-plane conditions
+  // of a planar loop of revolute joints): its multipliers are held at zero and its rows drop
+  // out of the saddle point, which would otherwise be singular. Its penalty part stays, and
+  // Phi_k is still measured.
+  void holdMultipliersAtZero(std::size_t k) { implied_.at(k) = true; }
+  bool multipliersHeldAtZero(std::size_t k) const { return implied_[k]; }
+
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -67,6 +75,7 @@ class QuadraticConstraint final : public Component {
 
   ConstraintSpec spec_;
   int positionCount_;
+  std::vector<bool> implied_;  // per form: multipliers held at zero
 };
 
 }  // namespace mpx

@@ -65,7 +65,7 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   build.addComponent(std::make_unique<Inertia>(
       name, phi, phiRate, std::vector<InertiaBlock>{{mass, true}, {E[0], false}, {E[1], false}, {E[2], false}},
       build.spec.gravity));
-  const JointBuilder builder(build.attachments[name], Attachment{});
+  const JointBuilder builder(build.attachments[name]);
   build.addConstraint(name + ".rigidity", builder, builder.rigidity(), rigidity, dofs);
 }
 

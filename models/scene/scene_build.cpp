@@ -152,7 +152,9 @@ void SceneBuild::addConstraint(const std::string& name, const JointBuilder& buil
     scale.segment(constraint.firstMultiplierDof, count).setOnes();
   }
   constraint.forms = std::move(forms);
-  addComponent(std::make_unique<QuadraticConstraint>(std::move(constraint)));
+  auto component = std::make_unique<QuadraticConstraint>(std::move(constraint));
+  constraints.push_back({component.get(), builder.ends()});
+  addComponent(std::move(component));
 }
 
 const SolidPlacement& SceneBuild::solidOf(ElementReader& in) const {

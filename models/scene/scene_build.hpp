@@ -11,6 +11,7 @@
 #include "models/fe/solid_element.hpp"
 #include "models/multibody/joint_builder.hpp"
 #include "models/multibody/joint_coordinate.hpp"
+#include "models/multibody/redundant_constraints.hpp"
 #include "models/scene/element_reader.hpp"
 #include "models/scene/scene_spec.hpp"
 #include "models/thermal/heat_link.hpp"
@@ -96,6 +97,7 @@ class SceneBuild {
   Layout layout;
   Eigen::VectorXd state, scale;  // initial state; Newton's scale per dof (0: not set)
   std::vector<std::unique_ptr<Component>> components;
+  std::vector<ConstraintEdge> constraints;  // among components: joints and body rigidity
   std::vector<std::string> thermalNodeNames;
   std::map<std::string, Endpoint> points;         // masses, anchors, bodies' centres
   std::map<std::string, Attachment> attachments;  // what joints may attach to

@@ -95,6 +95,7 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
                      ": <metriplex>: the scene has nothing to integrate (no mass, body, solid, thermal element "
                      "or reservoir)");
   setMechanicalScales(build, scene.settings.tEnd);
+  std::vector<RedundantConditions> redundant = holdRedundantMultipliers(build.constraints, build.state);
   auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
                                        build.thermalNodeNames, build.state, build.scale,
                                        std::move(build.prescribedMotions), std::move(build.loadBreakpoints));
@@ -103,7 +104,8 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
           std::move(model),
           std::move(build.bodyFrames),
           std::move(build.jointCoordinates),
-          std::move(build.solids)};
+          std::move(build.solids),
+          std::move(redundant)};
 }
 
 SceneSpec readScene(const std::string& path) {

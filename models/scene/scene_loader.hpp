@@ -4,6 +4,7 @@
 // settings) come back beside the model, with what output writers need to find bodies,
 // joints and solids in the state.
 #include "engine/core/model.hpp"
+#include "models/multibody/redundant_constraints.hpp"
 #include "models/scene/scene_build.hpp"
 #include "models/scene/scene_spec.hpp"
 
@@ -20,6 +21,7 @@ struct CompiledScene {
   std::vector<BodyFrame> bodies;
   std::vector<JointCoordinate> joints;  // revolute and prismatic joints, for joints.csv
   std::vector<SolidPlacement> solids;
+  std::vector<RedundantConditions> redundantConditions;  // their multipliers are held at zero
 };
 
 // Throws InputError (file, line, element, what is wrong) on any invalid input. When
