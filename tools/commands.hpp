@@ -30,6 +30,9 @@ struct RunRequest {
   int maxOrder = 5;
   bool sundialsKlu = false;
   std::optional<double> outputStep;
+  // one-step schemes, metriplex run only
+  int checkpointEvery = 0;  // steps between checkpoints in DIR/checkpoint.txt (0: only at a stop request)
+  std::string restart;      // a checkpoint file to continue from
 };
 
 // One integrator; DIR/history.csv; exit 3 on a solver failure.

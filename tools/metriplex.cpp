@@ -75,6 +75,11 @@ int main(int argc, char** argv) {
   run->add_flag("--sundials-klu", request.sundialsKlu,
                 "ida: factorise with SUNDIALS' KLU instead of Metriplex's sparse LU (KLU, UMFPACK for large systems)");
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
+  run->add_option("--checkpoint-every", request.checkpointEvery,
+                  "one-step integrators: write DIR/checkpoint.txt every N steps (always at SIGINT/SIGTERM)");
+  run->add_option("--restart", request.restart,
+                  "one-step integrators: continue the run from a checkpoint file; its history starts at the "
+                  "checkpoint's step");
   run->add_option("--output-interval", request.frameInterval,
                   "interval of bodies.csv and joints.csv rows and of solid frames (.vtu) (default: every history row)");
 

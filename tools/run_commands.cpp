@@ -1,5 +1,6 @@
 // metriplex run and metriplex compare.
 #include "tools/commands.hpp"
+#include "tools/output/checkpoint_file.hpp"
 #include "tools/output/frames_csv.hpp"
 #include "tools/output/history_csv.hpp"
 #include "tools/output/solid_frames.hpp"
@@ -25,6 +26,8 @@ struct PreparedRun {
   MethodParameters parameters;
   std::filesystem::path out;
   double frameInterval = 0.0;  // bodies.csv, joints.csv and solid frames
+  CheckpointIdentity identity;
+  std::optional<LoopState> resume;  // --restart
 };
 
 struct RunResult {
@@ -53,6 +56,32 @@ ProgressSink progressBar(const std::string& label) {
                100 * fraction);
     if (fraction >= 1.0) fmt::print(stderr, "\n");
   };
+}
+
+// --checkpoint-every and --restart: what checkpoints identify, and the state a restart
+// continues from (read and checked here, before anything is written).
+void prepareCheckpoints(const RunRequest& request, PreparedRun& run) {
+  if (request.checkpointEvery < 0)
+    throw InputError(fmt::format("option --checkpoint-every must be at least 1, got {}", request.checkpointEvery));
+  if (run.method.isIda() && (request.checkpointEvery > 0 || !request.restart.empty()))
+    throw InputError(
+        "options --checkpoint-every and --restart: integrator 'ida' cannot be checkpointed (its multistep history "
+        "cannot be saved and restored through SUNDIALS' interface); use a one-step integrator");
+  const MethodParameters& p = run.parameters;
+  const bool tolerances = p.adaptive;
+  run.identity = {run.scene.name,
+                  hashOfFile(request.scene),
+                  run.method.name,
+                  p.adaptive,
+                  run.scene.model->layout().total(),
+                  p.dt,
+                  tolerances ? p.relativeTolerance : 0.0,
+                  tolerances ? p.absoluteTolerance : 0.0};
+  if (request.restart.empty()) return;
+  run.resume = readCheckpoint(request.restart, run.identity);
+  if (!(run.resume->time < p.tEnd))
+    throw InputError(fmt::format("option --restart: the checkpoint is at t = {:.17g}, not before t_end = {:.17g}",
+                                 run.resume->time, p.tEnd));
 }
 
 // The default output directory is out/<scene>-<outSuffix>, or out/<scene>-<integrator> when
@@ -91,10 +120,17 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
           ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
           : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
-  return {*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
+  PreparedRun run{*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
+  prepareCheckpoints(request, run);
+  return run;
 }
 
-RunResult execute(const PreparedRun& run) {
+// Checkpoints of `metriplex run`, under the output directory.
+constexpr const char* kCheckpointFile = "checkpoint.txt";
+
+// Runs and writes the outputs; with `checkpoints`, a one-step run writes DIR/checkpoint.txt
+// every `checkpointEvery` steps and at a stop request, and continues from run.resume if set.
+RunResult execute(const PreparedRun& run, bool checkpoints = false, int checkpointEvery = 0) {
   std::error_code error;
   std::filesystem::create_directories(run.out, error);
   if (error)
@@ -105,8 +141,16 @@ RunResult execute(const PreparedRun& run) {
   SolidFrames solids(run.out, run.scene, run.frameInterval);
   RunResult result{
       run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {}, history.path()};
+  MethodParameters parameters = run.parameters;
+  if (!run.method.isIda() && checkpoints) {
+    parameters.checkpoints.every = checkpointEvery;
+    parameters.checkpoints.resume = run.resume ? &*run.resume : nullptr;
+    parameters.checkpoints.write = [&](const LoopState& state) {
+      writeCheckpoint((run.out / kCheckpointFile).string(), run.identity, state);
+    };
+  }
   result.summary = runMethod(
-      *run.scene.model, run.method, run.parameters,
+      *run.scene.model, run.method, parameters,
       [&](const StepRecord& r) {
         history.write(r);
         frames.write(r);
@@ -156,11 +200,12 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
 
 int runCommand(const RunRequest& request) {
   const PreparedRun run = prepare(request, "");
-  const RunResult result = execute(run);
+  const RunResult result = execute(run, true, request.checkpointEvery);
   printSummary(result, request, run);
   if (result.summary.interrupted) {
-    fmt::print(stderr, "metriplex: interrupted after step {} (t = {:.9g}); history kept in {}\n", result.summary.steps,
-               result.summary.interruptedTime, result.history.string());
+    fmt::print(stderr, "metriplex: interrupted after step {} (t = {:.9g}); history kept in {}{}\n",
+               result.summary.steps, result.summary.interruptedTime, result.history.string(),
+               run.method.isIda() ? "" : "; continue with --restart " + (run.out / kCheckpointFile).string());
     return kExitInterrupted;
   }
   if (!result.summary.failed) return 0;

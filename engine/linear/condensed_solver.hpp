@@ -32,6 +32,8 @@ class CondensedSolver {
   // between (simplified Newton), solve mixes its current values with the kept factorisation,
   // an approximate inverse, which is all simplified Newton asks. Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
+  // Forget the factorisation, its pivots and analysis: the next factorize starts as the first.
+  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows())); }
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Unknowns of the system actually factorised.

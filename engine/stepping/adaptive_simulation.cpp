@@ -62,6 +62,16 @@ class LocalError {
     states_.back() = z;
     count_ = std::min(count_ + 1, kHistory);
   }
+  void save(LoopState& out) const {
+    out.errorHistoryCount = count_;
+    out.errorTimes = times_;
+    out.errorStates = states_;
+  }
+  void resume(const LoopState& saved) {
+    count_ = saved.errorHistoryCount;
+    times_ = saved.errorTimes;
+    states_ = saved.errorStates;
+  }
   // True when three states of this stretch are known, so that ofStep applies.
   bool hasHistory() const { return count_ == kHistory; }
 
@@ -138,13 +148,14 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   newton.maxCutbacks = 0;
   Integrator integrator(model, options.scheme, newton);
   summary.linearSystem = integrator.linearSolver().describe();
-  RunReporter reporter(model, summary, sink, progress, options.tEnd);
+  const Checkpointing& checkpoints = options.checkpoints;
+  RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
   LocalError localError(model, control);
   const Landings landings(model.loadBreakpoints(), control.outputInterval, options.tEnd);
   const int n = model.layout().total();
   Eigen::VectorXd next(n), half(n), fullStep(n);
-  Flows crossed;
-  int accepted = 0;
+  Flows crossed = reporter.last().crossed;
+  int accepted = reporter.last().step;
   char newtonFailure[sizeof StepOutcome::failure] = "";
   // one step of the scheme, counted in the summary
   auto attempt = [&](const Eigen::VectorXd& from, double t, double dt, Eigen::VectorXd& to, StepOutcome& outcome) {
@@ -161,8 +172,14 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     return reporter.report(++accepted, time, dt, crossed, outcome.iterations, outcome.cutbacks);
   };
 
-  localError.restart(0.0, reporter.state());
   double proposed = options.dt;
+  localError.restart(0.0, reporter.state());
+  if (checkpoints.resume) {
+    integrator.resume(*checkpoints.resume);
+    localError.resume(*checkpoints.resume);
+    proposed = checkpoints.resume->proposedStep;
+  }
+  CheckpointSchedule schedule(checkpoints, accepted);
   const double smallest = kSmallestStepFraction * options.tEnd;
   while (reporter.last().time < options.tEnd) {
     const double t = reporter.last().time;
@@ -203,11 +220,14 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
       summary.failure = what;
       break;
     }
+    // a stop request after the first half still takes the second, so that a checkpoint
+    // falls where a step is complete
     if (doubling) {
-      if (!accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome)) break;
+      if (!accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome) && summary.failed) break;
       localError.accept(t + 0.5 * dt, reporter.state());
     }
-    if (!accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome)) break;
+    const bool goOn = accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome);
+    if (summary.failed) break;
     // the next step from the last one taken and its own error (a half step of a doubling has
     // half the pair's); a step shortened to land may be followed by one up to the size
     // proposed before, as far as its error allows
@@ -220,6 +240,15 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     } else {
       localError.accept(tNew, reporter.state());
     }
+    if (schedule.due(accepted, summary.interrupted)) {
+      LoopState saved;
+      reporter.save(saved);
+      integrator.checkpoint(saved);
+      localError.save(saved);
+      saved.proposedStep = proposed;
+      checkpoints.write(saved);
+    }
+    if (!goOn) break;
   }
   reporter.finish();
   return summary;

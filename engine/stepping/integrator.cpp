@@ -174,4 +174,20 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
   return outcome;
 }
 
+void Integrator::checkpoint(LoopState& out) {
+  out.predictorStart = lastStart_;
+  out.predictorEnd = lastEnd_;
+  out.predictorTime = lastTime_;
+  out.predictorDt = lastDt_;
+  solver_.startAfresh();
+  factorizedDt_ = 0.0;
+}
+
+void Integrator::resume(const LoopState& saved) {
+  lastStart_ = saved.predictorStart;
+  lastEnd_ = saved.predictorEnd;
+  lastTime_ = saved.predictorTime;
+  lastDt_ = saved.predictorDt;
+}
+
 }  // namespace mpx

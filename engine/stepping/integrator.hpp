@@ -6,6 +6,7 @@
 #include "engine/core/model.hpp"
 #include "engine/linear/assembler.hpp"
 #include "engine/linear/condensed_solver.hpp"
+#include "engine/stepping/loop_state.hpp"
 
 #include <Eigen/Dense>
 
@@ -51,6 +52,12 @@ class Integrator {
   // Advance state z at time t by dt into zNew, halving the step up to maxCutbacks times
   // when Newton fails. Allocates nothing.
   StepOutcome advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew);
+
+  // Checkpoint: save the predictor into `out` and start the linear solver afresh
+  // (engine/stepping/loop_state.hpp says why). Resume: take the predictor from a checkpoint,
+  // with a fresh solver.
+  void checkpoint(LoopState& out);
+  void resume(const LoopState& saved);
 
   // Residual and tangent of the step zOld -> zNew (exposed for tangent tests).
   Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);

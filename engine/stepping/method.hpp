@@ -37,6 +37,7 @@ struct MethodParameters {
   double outputInterval = 0.0;      // adaptive steps land on its multiples
   int maxOrder = 5;                 // IDA
   bool sundialsKlu = false;         // IDA: SUNDIALS' KLU rather than Metriplex's sparse LU
+  Checkpointing checkpoints;        // one-step schemes only (IDA's multistep history cannot be saved)
 };
 
 // Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a

@@ -7,21 +7,64 @@
 
 namespace mpx {
 
-RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd)
+RunReporter::RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd,
+                         const LoopState* resume)
     : model_(model),
       summary_(summary),
       sink_(std::move(sink)),
       progress_(std::move(progress)),
       tEnd_(tEnd),
       nextProgress_(0.01 * tEnd),
-      state_(model.initialState()),
+      state_(resume ? resume->state : model.initialState()),
       start_(std::chrono::steady_clock::now()) {
   model_.measure(state_, measures_);
   balance_ = EnergyBalance(measures_.energy);
   previousEntropy_ = measures_.entropy;
   record_.state = &state_;
   record_.measures = &measures_;
+  record_.initialEntropy = measures_.entropy;
+  if (resume) {
+    record_.initialEntropy = resume->initialEntropy;
+    balance_ = EnergyBalance(resume->initialEnergy, resume->energyScale, resume->largestEnergyError);
+    previousEntropy_ = resume->previousEntropy;
+    record_.step = resume->step;
+    record_.time = resume->time;
+    record_.dt = resume->dt;
+    record_.crossed = resume->crossed;
+    record_.newtonIterations = resume->newtonIterations;
+    record_.cutbacks = resume->cutbacks;
+    summary_.steps = resume->step;
+    summary_.newtonIterations = resume->totalNewtonIterations;
+    summary_.factorizations = resume->factorizations;
+    summary_.cutbacks = resume->totalCutbacks;
+    summary_.rejectedSteps = resume->rejectedSteps;
+    summary_.maxAbsoluteEnergyBalanceError = balance_.largestError();
+    summary_.maxEnergyBalanceError =
+        balance_.scale() > 0.0 ? balance_.largestError() / balance_.scale() : balance_.largestError();
+    summary_.minEntropyProduction = resume->minEntropyProduction;
+    nextProgress_ = resume->time + 0.01 * tEnd;
+  }
   sink_(record_);
+}
+
+void RunReporter::save(LoopState& out) const {
+  out.step = record_.step;
+  out.time = record_.time;
+  out.dt = record_.dt;
+  out.state = state_;
+  out.crossed = record_.crossed;
+  out.newtonIterations = record_.newtonIterations;
+  out.cutbacks = record_.cutbacks;
+  out.totalNewtonIterations = summary_.newtonIterations;
+  out.factorizations = summary_.factorizations;
+  out.totalCutbacks = summary_.cutbacks;
+  out.rejectedSteps = summary_.rejectedSteps;
+  out.initialEnergy = balance_.initial();
+  out.energyScale = balance_.scale();
+  out.largestEnergyError = balance_.largestError();
+  out.initialEntropy = record_.initialEntropy;
+  out.previousEntropy = previousEntropy_;
+  out.minEntropyProduction = summary_.minEntropyProduction;
 }
 
 namespace {
@@ -122,10 +165,13 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
   summary.linearSystem = integrator.linearSolver().describe();
   // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
   const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
-  RunReporter reporter(model, summary, sink, progress, options.tEnd);
+  const Checkpointing& checkpoints = options.checkpoints;
+  RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
+  if (checkpoints.resume) integrator.resume(*checkpoints.resume);
   Eigen::VectorXd next(reporter.state().size());
-  Flows crossed;
-  for (int n = 1; n <= steps; ++n) {
+  Flows crossed = reporter.last().crossed;
+  CheckpointSchedule schedule(checkpoints, reporter.last().step);
+  for (int n = reporter.last().step + 1; n <= steps; ++n) {
     const double t = reporter.last().time;
     const double dt = std::min(options.dt, options.tEnd - t);
     const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next);
@@ -141,8 +187,16 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     }
     reporter.state().swap(next);
     crossed += outcome.energy;
-    if (!reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks))
-      break;
+    const bool goOn =
+        reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks);
+    if (summary.failed) break;
+    if (schedule.due(n, summary.interrupted)) {
+      LoopState saved;
+      reporter.save(saved);
+      integrator.checkpoint(saved);
+      checkpoints.write(saved);
+    }
+    if (!goOn) break;
   }
   reporter.finish();
   return summary;

@@ -3,6 +3,7 @@
 // sink, and summarise the run (cost, conservation, failure). Adaptive steps:
 // engine/stepping/adaptive_simulation.hpp.
 #include "engine/stepping/integrator.hpp"
+#include "engine/stepping/loop_state.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +19,7 @@ struct RunOptions {
   double dt = 0.0;  // the step (the first step of an adaptive run)
   double tEnd = 0.0;
   NewtonSettings newton;
+  Checkpointing checkpoints;
 };
 
 // What one step reports; energies that crossed the boundary are accumulated since t = 0.
@@ -30,6 +32,7 @@ struct StepRecord {
   Flows crossed;
   int newtonIterations = 0;
   int cutbacks = 0;
+  double initialEntropy = 0.0;  // S at t = 0, against which entropy production is counted
 };
 
 // SUNDIALS IDA's counters for a run (see engine/ida_simulation.hpp).
@@ -49,12 +52,17 @@ struct IdaStatistics {
 class EnergyBalance {
  public:
   explicit EnergyBalance(double initialEnergy) : initial_(initialEnergy), scale_(std::abs(initialEnergy)) {}
+  // A balance kept so far (restart).
+  EnergyBalance(double initialEnergy, double scale, double largestError)
+      : initial_(initialEnergy), scale_(scale), largestError_(largestError) {}
   double relativeError(double energy, double dissipated, double externalWork, double boundaryHeat) {
     scale_ = std::max({scale_, std::abs(energy), std::abs(dissipated), std::abs(externalWork), std::abs(boundaryHeat)});
     largestError_ = std::max(largestError_, std::abs(energy + dissipated - externalWork - boundaryHeat - initial_));
     return scale_ > 0.0 ? largestError_ / scale_ : largestError_;
   }
   double largestError() const { return largestError_; }
+  double initial() const { return initial_; }
+  double scale() const { return scale_; }
 
  private:
   double initial_, scale_, largestError_ = 0.0;
@@ -100,10 +108,12 @@ using ProgressSink = std::function<void(double)>;
 
 // What the time loops share: the current state, its measures and the record handed to the
 // sink; the summary's conservation figures (energy balance error, entropy increments) and
-// wall time; the progress bar. Constructing it reports the initial state as step 0.
+// wall time; the progress bar. Constructing it reports the initial state as step 0, or the
+// step a restart resumes from, with the summary's figures as they were there.
 class RunReporter {
  public:
-  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd);
+  RunReporter(const Model& model, RunSummary& summary, StepSink sink, ProgressSink progress, double tEnd,
+              const LoopState* resume = nullptr);
 
   // The state the next report() describes; loops advance it in place.
   Eigen::VectorXd& state() { return state_; }
@@ -116,6 +126,8 @@ class RunReporter {
   bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
   // Record the wall time since construction in the summary.
   void finish();
+  // The last report and the summary's running figures, into a checkpoint.
+  void save(LoopState& out) const;
 
  private:
   const Model& model_;
@@ -133,6 +145,8 @@ class RunReporter {
 
 // Run from the model's initial state; step 0 reports the initial state. Stops at the first
 // step the integrator cannot complete (after its cut-backs) and reports it in the summary.
+// With options.checkpoints: a checkpoint every `every` steps and at a stop request, or a
+// run resumed from one.
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink,
                     const ProgressSink& progress = nullptr);
 

@@ -30,14 +30,12 @@ HistoryCsv::~HistoryCsv() {
 
 void HistoryCsv::write(const StepRecord& r) {
   const Measures& m = *r.measures;
-  if (first_) initialEntropy_ = m.entropy;
-  first_ = false;
   fmt::print(
       file_,
       "{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:."
       "17g},{:.17g},{},{},{:.17g}",
       r.time, r.dt, m.energy, m.entropy, r.crossed.dissipated, r.crossed.externalWork, r.crossed.boundaryHeat,
-      r.crossed.boundaryEntropy, m.entropy - initialEntropy_ - r.crossed.boundaryEntropy, m.momentum.x(),
+      r.crossed.boundaryEntropy, m.entropy - r.initialEntropy - r.crossed.boundaryEntropy, m.momentum.x(),
       m.momentum.y(), m.momentum.z(), m.angularMomentum.x(), m.angularMomentum.y(), m.angularMomentum.z(),
       r.newtonIterations, r.cutbacks, m.constraintViolation);
   for (double temperature : m.nodeTemperature) fmt::print(file_, ",{:.17g}", temperature);

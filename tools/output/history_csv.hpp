@@ -28,8 +28,6 @@ class HistoryCsv {
 
  private:
   std::vector<const SolidPlacement*> thermalSolids_;
-  double initialEntropy_ = 0.0;
-  bool first_ = true;
   std::FILE* file_ = nullptr;
   std::filesystem::path partPath_, finalPath_;
 };
