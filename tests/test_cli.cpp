@@ -1,6 +1,7 @@
 // End-to-end tests of the metriplex command line: exit codes, error messages that point at the
 // offending file, line, element and attribute, no output directory on invalid input, and
 // DIR/history.csv on success and on a solver failure.
+#include "cli_support.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -19,30 +20,8 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-// The exit codes tools/metriplex.cpp promises.
-constexpr int kExitSuccess = 0;
-constexpr int kExitInvalidInput = 2;
-constexpr int kExitSolverFailure = 3;
-
+using namespace mpx::test::cli;
 using mpx::test::readFile;
-
-std::vector<std::string> splitLines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream stream(text);
-  for (std::string line; std::getline(stream, line);) lines.push_back(line);
-  return lines;
-}
-
-std::vector<std::string> splitFields(const std::string& row) {
-  std::vector<std::string> fields;
-  std::istringstream stream(row);
-  for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
-  return fields;
-}
-
-// Single quotes keep the shell from splitting or expanding a path.
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 
 // `text` with its first `from` replaced by `to`: a valid scene with one defect.
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
@@ -70,45 +49,6 @@ const std::string kSwingElements =
     "  <heat_link name=\"to_wall\" a=\"spring\" b=\"wall\" conductivity=\"0.2\"/>";
 const std::string kSwingScene = sceneWith(kSwingElements);
 constexpr int kSwingSteps = 8;  // t_end / dt
-
-// What one run of the binary did.
-struct Invocation {
-  int exitCode = -1;
-  std::string out, err;
-};
-
-// Each test gets a fresh directory for its scene, its output and the captured streams.
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "metriplex-cli-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr) << "cannot create a temporary directory";
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path writeScene(const std::string& xml) const {
-    const fs::path path = dir_ / "scene.xml";
-    std::ofstream(path) << xml;
-    return path;
-  }
-  fs::path outDir() const { return dir_ / "out"; }
-
-  // Run `launcher metriplex arguments` with stdout and stderr captured to files.
-  Invocation metriplex(const std::string& arguments, const std::string& launcher = "") const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command =
-        launcher + quoted(METRIPLEX_BINARY) + " " + arguments + " > " + quoted(out) + " 2> " + quoted(err);
-    const int status = std::system(command.c_str());
-    Invocation result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readFile(out);
-    result.err = readFile(err);
-    return result;
-  }
-
-  fs::path dir_;
-};
 
 // One invalid scene: its text, extra options, the line its message must name and the words
 // (element, attribute, what is wrong) the message must contain.
