@@ -168,7 +168,9 @@ int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* 
   double* out = N_VGetArrayPointer(r);
   const Eigen::VectorXd& modelResidual = self.assembler_.residual();
   std::copy(modelResidual.data(), modelResidual.data() + self.modelSize_, out);
-  // a non-finite residual is recoverable: IDA retries with a smaller step
+  // a stop request ends IDASolve at once (an output interval can take long); a non-finite
+  // residual is recoverable: IDA retries with a smaller step
+  if (stopRequested()) return -1;
   return modelResidual.allFinite() ? 0 : 1;
 }
 
@@ -347,7 +349,13 @@ RunSummary simulateIda(const Model& model, const IdaOptions& options, const Step
   for (int k = 1; k <= outputs && !summary.failed; ++k) {
     const double tout = k == outputs ? options.tEnd : k * options.outputStep;
     if (!ida.advanceTo(tout)) {
-      fail(k, reporter.last().time, "IDASolve failed");
+      // a stop request within the interval: the run ends at the last output time
+      if (stopRequested()) {
+        summary.interrupted = true;
+        summary.interruptedTime = reporter.last().time;
+      } else {
+        fail(k, reporter.last().time, "IDASolve failed");
+      }
       break;
     }
     reporter.state() = Eigen::Map<const Eigen::VectorXd>(ida.state(), n);

@@ -97,7 +97,7 @@ struct RunSummary {
 };
 
 // A stop asked for from outside the run (the CLI's SIGINT and SIGTERM handlers): every time loop
-// ends after its next reported step (IDA: its next output time), with the summary marked
+// ends after its next reported step (IDA: at once, ending at its last output time), with the summary marked
 // interrupted. Safe to call from a signal handler; a request holds for the rest of the process.
 void requestStop() noexcept;
 bool stopRequested() noexcept;
