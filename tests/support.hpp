@@ -67,7 +67,7 @@ History collect(Runner runWith) {
 }
 
 inline History run(const Model& model, Scheme scheme, double dt, double tEnd, NewtonSettings newton = {}) {
-  return collect([&](const StepSink& sink) { return simulate(model, {scheme, dt, tEnd, newton}, sink); });
+  return collect([&](const StepSink& sink) { return simulate(model, {scheme, dt, tEnd, newton, {}}, sink); });
 }
 
 // SUNDIALS IDA at rtol = atol (per dof scale), history rows every outputStep (default t_end/20).

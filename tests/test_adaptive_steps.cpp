@@ -17,7 +17,7 @@ namespace {
 History runAdaptive(const Model& model, Scheme scheme, double rtol, double tEnd, double firstStep = 0.1,
                     double outputInterval = 0.0) {
   const History h = collect([&](const StepSink& sink) {
-    return simulateAdaptive(model, {scheme, firstStep, tEnd, {}}, {rtol, rtol, outputInterval}, sink);
+    return simulateAdaptive(model, {scheme, firstStep, tEnd, {}, {}}, {rtol, rtol, outputInterval}, sink);
   });
   EXPECT_FALSE(h.summary.failed) << h.summary.failure;
   return h;
