@@ -120,7 +120,7 @@ PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
           ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
           : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
-  PreparedRun run{*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0)};
+  PreparedRun run{*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0), {}, {}};
   prepareCheckpoints(request, run);
   return run;
 }
