@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <string>
 #include <vector>
@@ -100,6 +101,7 @@ TEST_F(CliTest, ACheckpointOfAnotherRunIsRefused) {
   const Case cases[] = {
       {"--dt 0.05", "another step"},
       {"--integrator midpoint", "another integrator"},
+      {"--adaptive", "another integrator"},
       {"--t-end 10", "not before t_end"},
   };
   for (const Case& c : cases) {
@@ -122,7 +124,31 @@ TEST_F(CliTest, ACheckpointOfAnotherRunIsRefused) {
   const Invocation damaged =
       metriplex("run " + kScene + " --restart " + quoted(dir_ / "damaged.txt") + " --out " + quoted(outDir()));
   EXPECT_EQ(damaged.exitCode, kExitInvalidInput);
-  EXPECT_NE(damaged.err.find("damaged.txt:12: 'x"), std::string::npos) << damaged.err;
+  EXPECT_NE(damaged.err.find("damaged.txt:13: 'x"), std::string::npos) << damaged.err;
+}
+
+// Frame outputs after a restart: the checkpoint's row, then the whole run's output times only
+TEST_F(CliTest, ARestartKeepsTheFrameTimesOfTheWholeRun) {
+  const std::string scene = quoted(fs::path(mpx::test::scenePath("four_bar_revolute.xml")));
+  const std::string options = " --checkpoint-every 7 --output-interval 0.1 --t-end ";
+  const fs::path whole = dir_ / "whole", half = dir_ / "half", restarted = dir_ / "restarted";
+  ASSERT_EQ(metriplex("run " + scene + options + "0.5 --out " + quoted(whole)).exitCode, kExitSuccess);
+  ASSERT_EQ(metriplex("run " + scene + options + "0.25 --out " + quoted(half)).exitCode, kExitSuccess);
+  ASSERT_EQ(metriplex("run " + scene + options + "0.5 --restart " + quoted(half / "checkpoint.txt") + " --out " +
+                      quoted(restarted))
+                .exitCode,
+            kExitSuccess);
+  auto times = [](const fs::path& bodies) {
+    std::vector<std::string> found;
+    for (const std::string& line : splitLines(readFile(bodies)))
+      if (line.find(",crank,") != std::string::npos) found.push_back(splitFields(line)[0]);
+    return found;
+  };
+  const std::vector<std::string> all = times(whole / "bodies.csv"), continued = times(restarted / "bodies.csv");
+  ASSERT_GE(continued.size(), 2u);
+  const std::vector<std::string> expected(std::find(all.begin(), all.end(), continued[1]), all.end());
+  EXPECT_EQ(std::vector<std::string>(continued.begin() + 1, continued.end()), expected);
+  EXPECT_EQ(expected.size(), 3u) << "t = 0.3, 0.4, 0.5";
 }
 
 TEST_F(CliTest, IdaRefusesCheckpoints) {

@@ -62,7 +62,8 @@ ProgressSink progressBar(const std::string& label) {
 // continues from (read and checked here, before anything is written).
 void prepareCheckpoints(const RunRequest& request, PreparedRun& run) {
   if (request.checkpointEvery < 0)
-    throw InputError(fmt::format("option --checkpoint-every must be at least 1, got {}", request.checkpointEvery));
+    throw InputError(
+        fmt::format("option --checkpoint-every must be 0 (none) or more, got {}", request.checkpointEvery));
   if (run.method.isIda() && (request.checkpointEvery > 0 || !request.restart.empty()))
     throw InputError(
         "options --checkpoint-every and --restart: integrator 'ida' cannot be checkpointed (its multistep history "
@@ -76,7 +77,8 @@ void prepareCheckpoints(const RunRequest& request, PreparedRun& run) {
                   run.scene.model->layout().total(),
                   p.dt,
                   tolerances ? p.relativeTolerance : 0.0,
-                  tolerances ? p.absoluteTolerance : 0.0};
+                  tolerances ? p.absoluteTolerance : 0.0,
+                  tolerances ? p.outputInterval : 0.0};
   if (request.restart.empty()) return;
   run.resume = readCheckpoint(request.restart, run.identity);
   if (!(run.resume->time < p.tEnd))
@@ -145,8 +147,13 @@ RunResult execute(const PreparedRun& run, bool checkpoints = false, int checkpoi
   if (!run.method.isIda() && checkpoints) {
     parameters.checkpoints.every = checkpointEvery;
     parameters.checkpoints.resume = run.resume ? &*run.resume : nullptr;
+    // a checkpoint that cannot be written (a full disk) is a warning: the run and its outputs go on
     parameters.checkpoints.write = [&](const LoopState& state) {
-      writeCheckpoint((run.out / kCheckpointFile).string(), run.identity, state);
+      try {
+        writeCheckpoint((run.out / kCheckpointFile).string(), run.identity, state);
+      } catch (const std::runtime_error& error) {
+        fmt::print(stderr, "metriplex: warning: no checkpoint after step {}: {}\n", state.step, error.what());
+      }
     };
   }
   result.summary = runMethod(

@@ -149,6 +149,8 @@ bool RunReporter::report(int step, double time, double dt, const Flows& crossed,
     progress_(std::min(1.0, time / tEnd_));
     nextProgress_ = time + 0.01 * tEnd_;
   }
+  // a run that reached t_end is complete, even if a stop came during its last step doubling
+  if (time >= tEnd_) summary_.interrupted = false;
   if (!stopRequested() || time >= tEnd_) return true;
   summary_.interrupted = true;
   summary_.interruptedTime = time;

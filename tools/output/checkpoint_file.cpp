@@ -28,6 +28,7 @@ void visitIdentity(Identity& id, Visit&& visit) {
   visit("dt", id.dt);
   visit("rtol", id.relativeTolerance);
   visit("atol", id.absoluteTolerance);
+  visit("output_interval", id.outputInterval);
 }
 
 template <class State, class Visit>
@@ -192,8 +193,11 @@ LoopState readCheckpoint(const std::string& path, const CheckpointIdentity& expe
       found.relativeTolerance == expected.relativeTolerance && found.absoluteTolerance == expected.absoluteTolerance,
       fmt::format("tolerance (--rtol {:.17g} --atol {:.17g})", found.relativeTolerance, found.absoluteTolerance));
   reader.dofs = expected.dofs;
+  require(found.outputInterval == expected.outputInterval,
+          fmt::format("output interval (--output-interval {:.17g}, where adaptive steps land)", found.outputInterval));
   LoopState state;
   visitState(state, reader);
+  if (state.errorHistoryCount > 3) throw InputError(path + ": error_history_count must be 0 to 3");
   reader.finish();
   if (state.state.size() == 0 || state.predictorStart.size() == 0 || state.predictorEnd.size() == 0)
     throw InputError(path + ": the state or the predictor's states are empty");

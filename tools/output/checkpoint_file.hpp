@@ -19,6 +19,7 @@ struct CheckpointIdentity {
   double dt = 0.0;
   double relativeTolerance = 0.0;
   double absoluteTolerance = 0.0;
+  double outputInterval = 0.0;  // adaptive steps land on its multiples
 };
 
 // FNV-1a of the file's bytes, in hex.

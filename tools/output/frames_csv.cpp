@@ -7,7 +7,7 @@
 namespace mpx {
 
 FramesCsv::FramesCsv(const std::filesystem::path& directory, const CompiledScene& scene, double interval)
-    : scene_(scene), interval_(interval) {
+    : scene_(scene), schedule_(interval) {
   if (!scene.bodies.empty()) open(bodies_, directory / "bodies.csv", "time,body,x,y,z,qw,qx,qy,qz");
   if (!scene.joints.empty()) open(joints_, directory / "joints.csv", "time,joint,position,velocity");
   for (const JointCoordinate& joint : scene.joints) jointPositions_.push_back(joint.initialPosition());
@@ -27,9 +27,7 @@ void FramesCsv::open(Output& output, const std::filesystem::path& path, const ch
 }
 
 void FramesCsv::write(const StepRecord& record) {
-  // rows at multiples of the interval (and at every step without one)
-  if (record.step > 0 && interval_ > 0.0 && record.time < nextOutput_ - 1e-9 * interval_) return;
-  nextOutput_ += interval_;
+  if (!schedule_.due(record.time)) return;
   const double* z = record.state->data();
   for (const BodyFrame& body : scene_.bodies) {
     Eigen::Matrix3d directors;

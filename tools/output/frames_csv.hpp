@@ -4,6 +4,7 @@
 // output time and body or joint. Written as .part files and renamed when the run ends.
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
+#include "tools/output/output_schedule.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -29,7 +30,7 @@ class FramesCsv {
   void open(Output& output, const std::filesystem::path& path, const char* header);
 
   const CompiledScene& scene_;
-  double interval_, nextOutput_ = 0.0;
+  OutputSchedule schedule_;
   Output bodies_, joints_;
   std::vector<double> jointPositions_;  // last written, to unwrap angles
 };

@@ -19,7 +19,7 @@ double vonMisesOf(const Mat3& sigma) {
 }  // namespace
 
 SolidFrames::SolidFrames(const std::filesystem::path& directory, const CompiledScene& scene, double interval)
-    : directory_(directory), interval_(interval) {
+    : directory_(directory), interval_(interval), schedule_(interval) {
   for (const SolidPlacement& solid : scene.solids) {
     std::filesystem::create_directories(directory / solid.name);
     series_.push_back({&solid, PvdSeries((directory / (solid.name + ".pvd")).string()), {}, {}});
@@ -28,9 +28,11 @@ SolidFrames::SolidFrames(const std::filesystem::path& directory, const CompiledS
 
 void SolidFrames::write(const StepRecord& record) {
   if (series_.empty()) return;
-  // frames at multiples of the interval (and at every step without one)
-  if (record.step > 0 && interval_ > 0.0 && record.time < nextOutput_ - 1e-9 * interval_) return;
-  nextOutput_ += interval_;
+  if (!schedule_.due(record.time)) return;
+  // frames are numbered by output time from t = 0, so a restart does not overwrite the first ones
+  frame_ = frame_ >= 0       ? frame_ + 1
+           : interval_ > 0.0 ? static_cast<int>(std::floor(record.time / interval_ - 1e-9)) + 1
+                             : record.step;
   const double* z = record.state->data();
   for (Series& s : series_) {
     const SolidPlacement& solid = *s.solid;
@@ -75,7 +77,6 @@ void SolidFrames::write(const StepRecord& record) {
     s.picture = thermal ? cellTemperature.values : vonMises.values;
     s.time = record.time;
   }
-  ++frame_;
 }
 
 void SolidFrames::finish() {

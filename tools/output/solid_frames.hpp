@@ -6,6 +6,7 @@
 // the temperature of a thermal solid or else by the von Mises stress.
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
+#include "tools/output/output_schedule.hpp"
 #include "tools/output/vtk_writer.hpp"
 
 #include <filesystem>
@@ -30,8 +31,9 @@ class SolidFrames {
     double time = 0.0;
   };
   std::filesystem::path directory_;
-  double interval_, nextOutput_ = 0.0;
-  int frame_ = 0;
+  double interval_;
+  OutputSchedule schedule_;
+  int frame_ = -1;  // the last frame written
   std::vector<Series> series_;
 };
 
