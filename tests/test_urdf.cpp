@@ -2,17 +2,15 @@
 // alone, a URDF pendulum swings with the analytic compound-pendulum period, every kind of
 // invalid URDF is rejected with exit code 2 and a message naming the element, the planar joint
 // leaves exactly the in-plane motion free, and the URDF scenes run, conserving energy under EEM.
+#include "cli_support.hpp"
 #include "models/scene/urdf_scene.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -26,17 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using Pose = Eigen::Isometry3d;
 
-constexpr int kExitSuccess = 0;
-constexpr int kExitInvalidInput = 2;  // tools/metriplex.cpp
-
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+using namespace cli;
 
 // Numbers with 17 digits, space separated, as URDF and scene attributes.
 std::string numbers(std::initializer_list<double> values) {
@@ -60,30 +48,13 @@ Vec3 centreOf(const Model& model, const Eigen::VectorXd& z, const std::string& n
 }
 
 // Each test writes its URDFs and scenes into a fresh directory.
-class UrdfTest : public ::testing::Test {
+class UrdfTest : public CliTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "metriplex-urdf-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr) << "cannot create a temporary directory";
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const std::string& file, const std::string& text) const {
     const fs::path path = dir_ / file;
     std::ofstream(path) << text;
     return path;
   }
-
-  // Exit code and stderr of `metriplex arguments`.
-  std::pair<int, std::string> metriplex(const std::string& arguments) const {
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = quoted(METRIPLEX_BINARY) + " " + arguments + " > /dev/null 2> " + quoted(err);
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readFile(err)};
-  }
-
-  fs::path dir_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -381,11 +352,11 @@ class BadUrdfTest : public UrdfTest, public ::testing::WithParamInterface<BadUrd
 TEST_P(BadUrdfTest, RunExitsTwoNamingTheFileAndElement) {
   const BadUrdf& c = GetParam();
   const fs::path urdf = write("bad.urdf", c.urdf);
-  const auto [code, err] = metriplex("run " + quoted(urdf) + " --out " + quoted(dir_ / "out"));
-  EXPECT_EQ(code, kExitInvalidInput) << err;
+  const Invocation r = metriplex("run " + quoted(urdf) + " --out " + quoted(dir_ / "out"));
+  EXPECT_EQ(r.exitCode, kExitInvalidInput) << r.err;
   const std::string where = urdf.string() + ":" + (c.line > 0 ? std::to_string(c.line) + ":" : "");
-  EXPECT_NE(err.find(where), std::string::npos) << err;
-  for (const std::string& mention : c.mentions) EXPECT_NE(err.find(mention), std::string::npos) << err;
+  EXPECT_NE(r.err.find(where), std::string::npos) << r.err;
+  for (const std::string& mention : c.mentions) EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
@@ -438,10 +409,10 @@ TEST_P(BadIncludeTest, RunExitsTwoAtTheUrdfElement) {
                                "  <simulation dt=\"0.01\" t_end=\"0.1\"/>\n"
                                "  <anchor name=\"pivot\"/>\n  " +
                                    c.elements + "\n</metriplex>\n");
-  const auto [code, err] = metriplex("run " + quoted(scene) + " --out " + quoted(dir_ / "out"));
-  EXPECT_EQ(code, kExitInvalidInput) << err;
-  EXPECT_NE(err.find(scene.string() + ":5:"), std::string::npos) << err;
-  for (const std::string& mention : c.mentions) EXPECT_NE(err.find(mention), std::string::npos) << err;
+  const Invocation r = metriplex("run " + quoted(scene) + " --out " + quoted(dir_ / "out"));
+  EXPECT_EQ(r.exitCode, kExitInvalidInput) << r.err;
+  EXPECT_NE(r.err.find(scene.string() + ":5:"), std::string::npos) << r.err;
+  for (const std::string& mention : c.mentions) EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
@@ -549,8 +520,8 @@ TEST_F(UrdfTest, UrdfFileRunsAsASceneWithDefaults) {
             robotWith({kWorld, kArm, kHinge, "<gazebo reference=\"arm\"><material>Gazebo/Blue</material></gazebo>",
                        "<transmission name=\"t\"><type>transmission_interface/SimpleTransmission</type>"
                        "</transmission>"}));
-  const auto [code, err] = metriplex("run " + quoted(urdf) + " --t-end 0.01 --out " + quoted(dir_ / "out"));
-  ASSERT_EQ(code, kExitSuccess) << err;
+  const Invocation r = metriplex("run " + quoted(urdf) + " --t-end 0.01 --out " + quoted(dir_ / "out"));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
   const std::string history = readFile(dir_ / "out" / "history.csv");
   EXPECT_EQ(std::count(history.begin(), history.end(), '\n'), 1 + 10 + 1) << "header, t = 0 and 10 steps of 1e-3 s";
 }
