@@ -23,7 +23,10 @@ void Damper::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&
 }
 
 void Damper::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  const Vec3 d = geometry_.separation(args.z), dRate = geometry_.separationRate(args.zdot);
+  // the length rate from the velocities, not from the position rates: under constraints the
+  // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
+  // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
+  const Vec3 d = geometry_.separation(args.z), dRate = geometry_.separationVelocity(args.z);
   const double length = d.norm();
   const Vec3 unit = d / length;
   const double lengthRate = unit.dot(dRate);
@@ -31,11 +34,12 @@ void Damper::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows
   geometry_.addForce(out, force * unit);
   flows.dissipated += force * lengthRate;
 
-  // z enters through the direction and the length rate, zdot through the length rate
+  // the positions enter through the direction and the length rate, the velocities through the
+  // length rate
   const Eigen::Matrix3d dUnit = (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / length;
   const Vec3 dLengthRateDd = dUnit * dRate;
-  geometry_.addSeparationTangent(out, args.alpha * (coefficient_ * unit * dLengthRateDd.transpose() + force * dUnit) +
-                                          args.beta * coefficient_ * unit * unit.transpose());
+  geometry_.addSeparationTangent(out, args.alpha * (coefficient_ * unit * dLengthRateDd.transpose() + force * dUnit));
+  geometry_.addSeparationVelocityTangent(out, args.alpha * coefficient_ * unit * unit.transpose());
 }
 
 }  // namespace mpx

@@ -44,6 +44,13 @@ Vec3 TwoPointGeometry::separation(const double* z) const { return pointIn(b_, z)
 
 Vec3 TwoPointGeometry::separationRate(const double* zdot) const { return rateIn(b_, zdot) - rateIn(a_, zdot); }
 
+Vec3 TwoPointGeometry::separationVelocity(const double* z) const {
+  auto velocity = [z](const Endpoint& end) {
+    return end.isMass() ? Vec3(z[end.velocityDof], z[end.velocityDof + 1], z[end.velocityDof + 2]) : Vec3::Zero();
+  };
+  return velocity(b_) - velocity(a_);
+}
+
 void TwoPointGeometry::addForce(LocalSystem& local, const Vec3& force) const {
   auto r = local.residual();
   if (localVelocityB_ >= 0) r.segment<3>(localVelocityB_) += force;
@@ -57,12 +64,21 @@ void TwoPointGeometry::addForceTangent(LocalSystem& local, const Vec3& direction
 }
 
 void TwoPointGeometry::addSeparationTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDd) const {
+  addMomentumTangent(local, dForceDd, localPositionB_, localPositionA_);
+}
+
+void TwoPointGeometry::addSeparationVelocityTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDw) const {
+  addMomentumTangent(local, dForceDw, localVelocityB_, localVelocityA_);
+}
+
+void TwoPointGeometry::addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, int columnB,
+                                          int columnA) const {
   auto K = local.tangent();
   const int rows[2] = {localVelocityB_, localVelocityA_};
-  const int cols[2] = {localPositionB_, localPositionA_};
+  const int cols[2] = {columnB, columnA};
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j)
-      if (rows[i] >= 0 && cols[j] >= 0) K.block<3, 3>(rows[i], cols[j]) += (i == j ? 1.0 : -1.0) * dForceDd;
+      if (rows[i] >= 0 && cols[j] >= 0) K.block<3, 3>(rows[i], cols[j]) += (i == j ? 1.0 : -1.0) * dForce;
 }
 
 void TwoPointGeometry::addSeparationRow(LocalRow& row, const Vec3& w) const {

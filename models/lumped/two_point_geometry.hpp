@@ -26,12 +26,17 @@ class TwoPointGeometry {
   Vec3 separation(const double* z) const;
   // Rate of the separation from the position part of zdot.
   Vec3 separationRate(const double* zdot) const;
+  // v_b - v_a in state z: the separation rate the velocities state, which a rate form under
+  // constraints should use (there q' = v - mu dPhi/dq carries the GGL multiplier).
+  Vec3 separationVelocity(const double* z) const;
   // Add +force to b's and -force to a's momentum rows.
   void addForce(LocalSystem& local, const Vec3& force) const;
   // Add force-direction x dForce/dz to the momentum rows: b's rows +, a's rows -.
   void addForceTangent(LocalSystem& local, const Vec3& direction, const LocalRow& dForce) const;
   // Add dForce/dd (3x3) for a force that depends on the separation d of the state.
   void addSeparationTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDd) const;
+  // Add dForce/dw (3x3) for a force that depends on the separation velocity w of the state.
+  void addSeparationVelocityTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDw) const;
   // Row over local dofs of d(w . d)/dz.
   void addSeparationRow(LocalRow& row, const Vec3& w) const;
   // Whether local dof `local` is an end point's position (a row these elements never write).
@@ -42,6 +47,9 @@ class TwoPointGeometry {
 
  private:
   Endpoint a_, b_;
+  // Add dForce/dy (3x3) to the momentum rows for columns y of b (+) and a (-).
+  void addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, int columnB, int columnA) const;
+
   int localPositionA_ = -1, localVelocityA_ = -1, localPositionB_ = -1, localVelocityB_ = -1;
 };
 

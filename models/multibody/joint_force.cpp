@@ -106,8 +106,8 @@ double JointForce::dissipativeForce(double rate, double* dForce) const {
   return spec_.damping * rate + spec_.friction * slip;
 }
 
-void JointForce::deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out,
-                         Flows& flows) const {
+void JointForce::deposit(double power, const ConstraintRow& dPowerDq, const ConstraintRow& dPowerDv,
+                         double dPowerDgamma, LocalSystem& out, Flows& flows) const {
   // the dissipated power heats the node, or leaves the system
   if (localHeat_ < 0) {
     flows.dissipated += power;
@@ -115,6 +115,7 @@ void JointForce::deposit(double power, const ConstraintRow& dPowerDq, double dPo
   }
   out.residual()[localHeat_] -= power;
   out.tangent().block(localHeat_, 0, 1, n_) -= dPowerDq;
+  out.tangent().block(localHeat_, n_, 1, n_) -= dPowerDv;
   if (localInternal_ >= 0) out.tangent()(localHeat_, localInternal_) -= dPowerDgamma;
 }
 
@@ -166,11 +167,14 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
     dPowerDgamma = 2.0 * g / nu * dgDgamma;
   }
 
-  deposit(power, dPowerDq, dPowerDgamma, out, flows);
+  deposit(power, dPowerDq, ConstraintRow::Zero(n_), dPowerDgamma, out, flows);
 }
 
 void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  const ConstraintVector q = gather(args.z, 0), qRate = gather(args.zdot, 0);
+  // the coordinate rate from the velocities, not from the position rates: under constraints the
+  // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
+  // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
+  const ConstraintVector q = gather(args.z, 0), qRate = gather(args.z, spec_.velocityShift);
   const Vec3 a = arguments(args.z);
   const int m = static_cast<int>(spec_.invariants.size());
   const ArgumentJacobian J = invariantJacobian(q);
@@ -184,18 +188,19 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
   auto K = out.tangent();
   r.segment(n_, n_) += J.transpose() * forceOnArguments;
 
-  // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dq'
+  // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dv
   ConstraintRow dRateDq = (angle.hess * invariantRate).transpose() * J;
   for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * qRate).transpose();
-  const ConstraintRow dRateDqRate = angle.grad.transpose() * J;
+  const ConstraintRow dRateDv = angle.grad.transpose() * J;
   const ConstraintVector direction = J.transpose() * angle.grad;
   K.block(n_, 0, n_, n_) +=
-      args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * (dForce * dRateDq)) +
-      args.beta * direction * (dForce * dRateDqRate);
+      args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * (dForce * dRateDq));
+  K.block(n_, n_, n_, n_) += args.alpha * direction * (dForce * dRateDv);
   for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * forceOnArguments[i] * spec_.invariants[i].hessian;
 
   double power = force * rate;
-  ConstraintRow dPowerDq = (dForce * rate + force) * (args.alpha * dRateDq + args.beta * dRateDqRate);
+  ConstraintRow dPowerDq = (dForce * rate + force) * args.alpha * dRateDq;
+  const ConstraintRow dPowerDv = (dForce * rate + force) * args.alpha * dRateDv;
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     // nu gamma' = -de/dgamma, dissipating (de/dgamma)^2 / nu
@@ -209,7 +214,7 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
     dPowerDq += args.alpha * (2.0 * g / nu) * dgDq;
     dPowerDgamma = -args.alpha * (2.0 * g / nu) * e.hess(kInternal, kInternal);
   }
-  deposit(power, dPowerDq, dPowerDgamma, out, flows);
+  deposit(power, dPowerDq, dPowerDv, dPowerDgamma, out, flows);
 }
 
 }  // namespace mpx

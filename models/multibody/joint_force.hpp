@@ -54,8 +54,10 @@ class JointForce final : public Component {
   using ArgumentJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxConstrainedDofs>;
   ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;
   unsigned mask() const;
-  // Send the dissipated power (with its tangent row) to the heat node, or to the flows.
-  void deposit(double power, const ConstraintRow& dPowerDq, double dPowerDgamma, LocalSystem& out, Flows& flows) const;
+  // Send the dissipated power (with its tangent row over q, v and gamma) to the heat node, or
+  // to the flows.
+  void deposit(double power, const ConstraintRow& dPowerDq, const ConstraintRow& dPowerDv, double dPowerDgamma,
+               LocalSystem& out, Flows& flows) const;
 
   JointForceSpec spec_;
   int n_;  // number of constrained positions
