@@ -394,16 +394,40 @@ TEST_F(CliTest, UnknownSubcommandAndUnusableOutputDirectoryAreNamed) {
 }
 
 // IDA's rate form cannot impose a displacement step by step: refused before anything is written,
-// naming the scene and the element (run and bench, whose reference is an IDA run).
+// naming the scene and the element (run, and bench when ida is all it is asked for).
 TEST_F(CliTest, IdaRefusesAPrescribedDisplacement) {
   const fs::path scene = writeScene(readFile(mpx::test::scenePath("stretched_bar.xml")));
-  for (const std::string command : {"run --integrator ida", "bench --integrators eem"}) {
+  for (const std::string command : {"run --integrator ida", "bench --integrators ida"}) {
     const Invocation r = metriplex(command + " " + quoted(scene) + " --out " + quoted(outDir()));
     EXPECT_EQ(r.exitCode, kExitInvalidInput) << command << ": " << r.err;
     EXPECT_NE(r.err.find(scene.string()), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("<prescribed_displacement>"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(outDir()));
   }
+}
+
+// A scene IDA cannot run is benched against EEM at a 64th of the scene's step, shown converged
+// against EEM at a 32nd; ida leaves the sweep with the reason, and the errors fall at order 2.
+TEST_F(CliTest, BenchMeasuresASceneIdaRefusesAgainstFineEem) {
+  std::string xml = readFile(mpx::test::scenePath("stretched_bar.xml"));
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"cells=\"8 2 2\"", "cells=\"2 1 1\""},
+                                 {"dt=\"0.02\" t_end=\"4\"", "dt=\"0.05\" t_end=\"0.5\""}}) {
+    ASSERT_NE(xml.find(from), std::string::npos) << from;
+    xml.replace(xml.find(from), from.size(), to);
+  }
+  const Invocation r = metriplex("bench " + quoted(writeScene(xml)) +
+                                 " --integrators eem,ida --dts 0.0125,0.00625 --repeats 1 --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  EXPECT_NE(r.out.find("ida left out"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("reference: eem dt 0.00078125"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("differs from EEM at dt 0.0015625"), std::string::npos) << r.out;
+  const std::vector<std::string> lines = splitLines(readFile(outDir() / "work_precision.csv"));
+  ASSERT_EQ(lines.size(), 1u + 2);  // eem over 2 steps, both in the asymptotic range
+  const std::vector<std::string> header = splitFields(lines.front());
+  const auto errorColumn = std::find(header.begin(), header.end(), "error") - header.begin();
+  const double coarse = std::stod(splitFields(lines[1])[errorColumn]),
+               fine = std::stod(splitFields(lines[2])[errorColumn]);
+  EXPECT_NEAR(coarse / fine, 4.0, 1.0) << coarse << " " << fine;
 }
 
 class BadOptionsTest : public CliTest, public ::testing::WithParamInterface<BadOptions> {};

@@ -188,6 +188,8 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
   } else {
     if (run.parameters.adaptive) fmt::print("  rejected steps           {}\n", s.rejectedSteps);
     fmt::print("  cut-backs                {}\n", s.cutbacks);
+    fmt::print("  factorisations           {} ({:.2f} per step)\n", s.factorizations,
+               perStep(s.factorizations, s.steps));
   }
   fmt::print("  linear system            {}\n", s.linearSystem);
   if (!run.scene.redundantConditions.empty())
