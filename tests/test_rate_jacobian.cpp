@@ -52,6 +52,33 @@ TEST_P(RateJacobian, MatchesCentralDifferences) {
   }
 }
 
+// IDA's residual calls ask for no tangent (alpha = beta = 0): the residual and the flows are
+// those of a full evaluation, bit for bit, and the tangent stays zero (multibody, lumped and
+// thermal fixtures, and viscoelastic and thermo-viscoelastic solids, which skip the tangent).
+TEST(ResidualOnlyEvaluation, MatchesTheFullOne) {
+  for (const char* file : {"flyball_governor.xml", "damped_double_pendulum.xml", "two_thermo_springs.xml",
+                           "thermo_visco_elastic.xml", "lblock_viscoelastic.xml", "lblock_thermoviscoelastic.xml"}) {
+    SCOPED_TRACE(file);
+    const CompiledScene scene = loadScene(scenePath(file));
+    const Model& model = *scene.model;
+    Assembler assembler(model);
+    Workspace workspace = model.makeWorkspace();
+    const VectorXd z = model.initialState() + 1e-3 * randomIsh(magnitudeAt(model, model.initialState()), 23);
+    const VectorXd zdot = randomIsh(magnitudeAt(model, z), 29);
+    assembler.clear();
+    assembler.addRate(model, workspace, {z.data(), zdot.data(), 0.1, 1.0, 0.5}, 1.0);
+    const VectorXd full = assembler.residual();
+    const Flows fullFlows = assembler.flows();
+    assembler.clear();
+    assembler.addRate(model, workspace, {z.data(), zdot.data(), 0.1, 0.0, 0.0}, 1.0);
+    EXPECT_EQ((assembler.residual() - full).lpNorm<Eigen::Infinity>(), 0.0);
+    EXPECT_EQ(assembler.flows().dissipated, fullFlows.dissipated);
+    EXPECT_EQ(assembler.flows().boundaryHeat, fullFlows.boundaryHeat);
+    const Eigen::SparseMatrix<double>& tangent = assembler.tangent();
+    EXPECT_EQ(Eigen::Map<const VectorXd>(tangent.valuePtr(), tangent.nonZeros()).lpNorm<Eigen::Infinity>(), 0.0);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(FixtureScenes, RateJacobian,
                          ::testing::Values("flyball_governor.xml", "double_pendulum.xml", "damped_double_pendulum.xml",
                                            "heavy_top.xml", "free_floating_chain.xml", "two_thermo_springs.xml",

@@ -39,7 +39,8 @@ struct StepArgs {
   double dt;
 };
 
-// A rate evaluation F(t, z, zdot); the tangent wanted is alpha dF/dz + beta dF/dzdot.
+// A rate evaluation F(t, z, zdot); the tangent wanted is alpha dF/dz + beta dF/dzdot (none when
+// both are 0: a component may then skip computing it).
 struct RateArgs {
   const double* z;
   const double* zdot;

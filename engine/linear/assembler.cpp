@@ -73,7 +73,8 @@ void Assembler::clear() {
   flows_ = Flows{};
 }
 
-void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight) {
+void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
+                        bool withTangent) {
   assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
   double* values = tangent_.valuePtr();
   for (int i = 0; i < local.n; ++i) {
@@ -81,6 +82,7 @@ void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, con
     if (!std::isfinite(local.r[i]) && firstNonFinite_.component < 0)
       firstNonFinite_ = {static_cast<int>(component), dofs[i]};
   }
+  if (!withTangent) return;
   for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
 }
 

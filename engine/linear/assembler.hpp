@@ -27,7 +27,8 @@ class Assembler {
   void clear();
   // Add every component's EEM step residual and tangent.
   void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
-    add(model, ws, 1.0, [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
+    add(model, ws, 1.0, true,
+        [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
   }
   // Replace the rows of prescribed motions for the step zOld -> zNew: v' = V(t + dt) (tangent
   // 1/dt) or (v + v')/2 = (u(t + dt) - u(t))/dt (tangent 1/2), with the reaction's work at the
@@ -36,9 +37,10 @@ class Assembler {
   // The same in rate form, for prescribed velocities: vdot = dV/dt(t), tangent beta.
   void imposeRateMotions(const Model& model, const double* z, const double* zdot, double t, double beta);
   // Add every component's rate residual and tangent times `weight` (trapezoidal rule: two
-  // evaluations of weight 1/2).
+  // evaluations of weight 1/2). With alpha = beta = 0 only the residual is wanted (IDA's
+  // residual calls): the tangent is left at zero.
   void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
-    add(model, ws, weight,
+    add(model, ws, weight, args.alpha != 0.0 || args.beta != 0.0,
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
   }
 
@@ -46,13 +48,13 @@ class Assembler {
   // Evaluate every component with evaluate(component, workspace, local, flows) and add the
   // result times `weight`.
   template <class Evaluate>
-  void add(const Model& model, Workspace& ws, double weight, const Evaluate& evaluate) {
+  void add(const Model& model, Workspace& ws, double weight, bool withTangent, const Evaluate& evaluate) {
     // couplings read the node temperatures their owners publish: all owners come first
-    addRange(model, 0, firstCoupling_, ws, weight, evaluate);
-    addRange(model, firstCoupling_, model.components().size(), ws, weight, evaluate);
+    addRange(model, 0, firstCoupling_, ws, weight, withTangent, evaluate);
+    addRange(model, firstCoupling_, model.components().size(), ws, weight, withTangent, evaluate);
   }
   template <class Evaluate>
-  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, double weight,
+  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, double weight, bool withTangent,
                 const Evaluate& evaluate) {
     const auto& components = model.components();
     for (std::size_t first = begin; first < end; first += kBatch) {
@@ -74,7 +76,7 @@ class Assembler {
         for (int b = 0; b < count; ++b) evaluateSlot(b);
       }
       for (int b = 0; b < count; ++b) {
-        scatter(first + b, components[first + b]->dofs(), locals_[b], weight);
+        scatter(first + b, components[first + b]->dofs(), locals_[b], weight, withTangent);
         flows_ += localFlows_[b] * weight;
       }
     }
@@ -107,7 +109,8 @@ class Assembler {
   // the reaction (the row's residual before) does work at velocity `conjugate`, or, for a
   // temperature, is heat that enters at temperature `conjugate`.
   void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate);
-  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight);
+  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
+               bool withTangent);
 
   NonFiniteEntry firstNonFinite_;
   Eigen::VectorXd residual_;

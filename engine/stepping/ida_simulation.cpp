@@ -63,7 +63,8 @@ class IdaProblem {
   static int jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* self, N_Vector,
                       N_Vector, N_Vector);
   static void errorHandler(int code, const char* module, const char* function, char* message, void* self);
-  void evaluate(double t, N_Vector y, N_Vector yp, double cj);
+  // F and alpha dF/dy + cj dF/dyp (alpha = cj = 0: the residual alone, for IDA's residual calls)
+  void evaluate(double t, N_Vector y, N_Vector yp, double alpha, double cj);
   void setFirstStep(double firstOutput);
   void check(int flag, const char* call) const;
 
@@ -156,15 +157,15 @@ void IdaProblem::errorHandler(int code, const char*, const char* function, char*
   if (code < 0) static_cast<IdaProblem*>(self)->error_ = std::string(function) + ": " + message;
 }
 
-void IdaProblem::evaluate(double t, N_Vector y, N_Vector yp, double cj) {
+void IdaProblem::evaluate(double t, N_Vector y, N_Vector yp, double alpha, double cj) {
   assembler_.clear();
-  assembler_.addRate(model_, workspace_, {N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, 1.0, cj}, 1.0);
+  assembler_.addRate(model_, workspace_, {N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, alpha, cj}, 1.0);
   assembler_.imposeRateMotions(model_, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, cj);
 }
 
 int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* user) {
   auto& self = *static_cast<IdaProblem*>(user);
-  self.evaluate(t, y, yp, 0.0);
+  self.evaluate(t, y, yp, 0.0, 0.0);
   double* out = N_VGetArrayPointer(r);
   const Eigen::VectorXd& modelResidual = self.assembler_.residual();
   std::copy(modelResidual.data(), modelResidual.data() + self.modelSize_, out);
@@ -177,7 +178,7 @@ int IdaProblem::residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* 
 int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* user, N_Vector,
                          N_Vector, N_Vector) {
   auto& self = *static_cast<IdaProblem*>(user);
-  self.evaluate(t, y, yp, cj);
+  self.evaluate(t, y, yp, 1.0, cj);
   const Eigen::SparseMatrix<double>& K = self.assembler_.tangent();
   const int n = self.modelSize_;
   if (self.dense_) {
@@ -197,7 +198,7 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
 
 int IdaProblem::flows(realtype t, N_Vector y, N_Vector yp, N_Vector rates, void* user) {
   auto& self = *static_cast<IdaProblem*>(user);
-  self.evaluate(t, y, yp, 0.0);
+  self.evaluate(t, y, yp, 0.0, 0.0);
   const Flows& flows = self.assembler_.flows();
   double* out = N_VGetArrayPointer(rates);
   out[0] = flows.dissipated;
@@ -230,7 +231,7 @@ bool IdaProblem::initialise(double firstOutput) {
   N_VConst(0.0, yp_);
   double* y = N_VGetArrayPointer(y_);
   for (int i = layout.offset(Block::Multiplier); i < n; ++i) y[i] = 0.0;
-  evaluate(0.0, y_, yp_, 0.0);  // alpha = 1, beta = 0: F and dF/dz
+  evaluate(0.0, y_, yp_, 1.0, 0.0);  // alpha = 1, beta = 0: F and dF/dz
   const Eigen::VectorXd residual = assembler_.residual();
   const Eigen::SparseMatrix<double> dFdz = assembler_.tangent();
   assembler_.clear();

@@ -112,10 +112,14 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
                             (zNew.head(unknownsWithScale_).array().abs() + scale.head(unknownsWithScale_).array()))
                                .maxCoeff();
     residualNorm = rescaledNorm(system);
-    // keep the factorisation while the iteration contracts well (or has converged)
-    refresh =
-        settings_.reuseContraction <= 0.0 || (incrementNorm > settings_.incrementTolerance &&
-                                              !(incrementNorm <= settings_.reuseContraction * previousIncrementNorm));
+    // keep the factorisation while the iteration contracts well (or has converged); full Newton
+    // keeps it too once the increment is small: a tangent taken that close to the solution
+    // contracts the next increment about as much as a fresh one (by about its own size)
+    const bool closeEnough = incrementNorm <= settings_.reuseBelowIncrement;
+    refresh = settings_.reuseContraction <= 0.0
+                  ? !closeEnough
+                  : incrementNorm > settings_.incrementTolerance &&
+                        !(incrementNorm <= settings_.reuseContraction * previousIncrementNorm);
   }
 }
 

@@ -59,6 +59,7 @@ void readSolver(ElementReader& in, NewtonSettings& n) {
   n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks, 50);
   n.predictor = in.flag("predictor", n.predictor);
   n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
+  n.reuseBelowIncrement = in.nonNegative("reuse_below_increment", n.reuseBelowIncrement);
   if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
   if (!(n.reuseContraction < 1.0)) in.fail("reuse_contraction must be below 1 (0: full Newton)");
 }
