@@ -26,8 +26,8 @@ class TwoPointGeometry {
   Vec3 separation(const double* z) const;
   // Rate of the separation from the position part of zdot.
   Vec3 separationRate(const double* zdot) const;
-  // v_b - v_a in state z: the separation rate the velocities state, which a rate form under
-  // constraints should use (there q' = v - mu dPhi/dq carries the GGL multiplier).
+  // v_b - v_a in state z: the separation rate as the velocities give it. Rate forms use it,
+  // because under constraints q' = v - mu dPhi/dq carries the GGL multiplier.
   Vec3 separationVelocity(const double* z) const;
   // Add +force to b's and -force to a's momentum rows.
   void addForce(LocalSystem& local, const Vec3& force) const;
@@ -46,10 +46,10 @@ class TwoPointGeometry {
   }
 
  private:
-  Endpoint a_, b_;
   // Add dForce/dy (3x3) to the momentum rows for columns y of b (+) and a (-).
   void addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, int columnB, int columnA) const;
 
+  Endpoint a_, b_;
   int localPositionA_ = -1, localVelocityA_ = -1, localPositionB_ = -1, localVelocityB_ = -1;
 };
 
