@@ -467,6 +467,36 @@ TEST_F(CliTest, RunWritesOneHistoryRowPerStepPlusOne) {
   EXPECT_FALSE(fs::exists(outDir() / "history.csv.part"));
 }
 
+// DIR/summary.json says what the printed summary says, machine-readably
+TEST_F(CliTest, RunWritesItsSummaryAsJson) {
+  const Invocation r = metriplex("run " + quoted(writeScene(kSwingScene)) + " --out " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  const std::string json = readFile(outDir() / "summary.json");
+  EXPECT_EQ(json.front(), '{');
+  for (const std::string& field :
+       std::vector<std::string>{"\"status\": \"ok\"", "\"integrator\": \"eem\"",
+                                "\"steps\": " + std::to_string(kSwingSteps), "\"max_relative_energy_drift\": "})
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  EXPECT_FALSE(fs::exists(outDir() / "summary.json.part"));
+}
+
+// metriplex plot renders a run's history to PNGs in its directory; a directory without a
+// history is invalid input
+TEST_F(CliTest, PlotRendersTheHistoryToPng) {
+  ASSERT_EQ(metriplex("run " + quoted(writeScene(kSwingScene)) + " --out " + quoted(outDir())).exitCode, kExitSuccess);
+  const Invocation r = metriplex("plot " + quoted(outDir()));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  for (const char* png : {"energy.png", "entropy.png", "constraint_violation.png"}) {
+    const std::string picture = readFile(outDir() / png);
+    EXPECT_EQ(picture.substr(1, 3), "PNG") << png;
+    EXPECT_NE(r.out.find(png), std::string::npos) << r.out;
+  }
+  const Invocation missing = metriplex("plot " + quoted(dir_ / "nothing"));
+  EXPECT_EQ(missing.exitCode, kExitInvalidInput);
+  EXPECT_NE(missing.err.find("history.csv"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir_ / "nothing"));
+}
+
 // A solid writes a ParaView series, one frame per --output-interval, each frame with all of its
 // nodes and cells, and a picture of the last frame; no .part file stays behind.
 TEST_F(CliTest, SolidRunWritesAParaViewSeriesAndAPicture) {
@@ -568,6 +598,9 @@ TEST_F(CliTest, SolverFailureExitsThreeAndKeepsTheGoodSteps) {
   ASSERT_EQ(lines.size(), 1 + 5 + 1);  // header, t = 0, 0.125, ..., 0.5, failure line
   EXPECT_EQ(std::stod(splitFields(lines[5]).front()), 0.5);
   EXPECT_EQ(lines.back().rfind("# solver failure", 0), 0u) << lines.back();
+  const std::string json = readFile(outDir() / "summary.json");
+  EXPECT_NE(json.find("\"status\": \"failed\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"failure\": {\"step\": 5, \"time\": 0.5"), std::string::npos) << json;
 }
 
 // Both default integrators run, each into its own directory, and the table reports them ok.

@@ -1,6 +1,8 @@
 #pragma once
 // The metriplex subcommands. Each validates all of its input before it writes anything and
 // returns the process exit code; invalid input throws InputError (exit code 2).
+#include "tools/session/run_session.hpp"
+
 #include <exception>
 #include <optional>
 #include <string>
@@ -15,24 +17,6 @@ inline constexpr int kExitInterrupted = 4;  // SIGINT or SIGTERM: stopped at a s
 // A run stopped by SIGINT or SIGTERM where the command cannot report it itself (bench).
 struct RunInterrupted : std::exception {
   const char* what() const noexcept override { return "interrupted (SIGINT or SIGTERM)"; }
-};
-
-struct RunRequest {
-  std::string scene;
-  std::string integrator;  // empty: the scene's default
-  std::optional<double> dt, tEnd;
-  std::string out;                      // empty: a directory under out/ named after the scene
-  std::optional<double> frameInterval;  // bodies.csv and joints.csv rows; empty: every step
-  bool adaptive = false;                // one-step schemes; also when the scene says so
-  // IDA and adaptive steps; empty: the scene's
-  std::optional<double> relativeTolerance, absoluteTolerance;
-  // IDA only
-  int maxOrder = 5;
-  bool sundialsKlu = false;
-  std::optional<double> outputStep;
-  // one-step schemes, metriplex run only
-  int checkpointEvery = 0;  // steps between checkpoints in DIR/checkpoint.txt (0: only at a stop request)
-  std::string restart;      // a checkpoint file to continue from
 };
 
 // One integrator; DIR/history.csv; exit 3 on a solver failure.

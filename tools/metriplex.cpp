@@ -1,6 +1,7 @@
 // metriplex: run scenes with EEM and standard integrators from the command line.
 // Exit codes: 0 success, 2 invalid input or arguments, 3 solver failure.
 #include "tools/commands.hpp"
+#include "tools/output/history_plots.hpp"
 
 #include "engine/core/input_error.hpp"
 #include "engine/stepping/simulation.hpp"
@@ -108,11 +109,16 @@ int main(int argc, char** argv) {
   benchCommandLine->add_option("--repeats", bench.repeats, "repeats per run (median CPU time)")->capture_default_str();
   benchCommandLine->add_option("--out", request.out, "output directory (default: out/<scene name>-bench)");
 
+  std::string plotDirectory;
+  CLI::App* plot = app.add_subcommand(
+      "plot", "render DIR/history.csv to PNG: energy.png, entropy.png, temperatures.png, constraint_violation.png");
+  plot->add_option("DIR", plotDirectory, "a run's output directory (metriplex run --out)")->required();
+
   // CLI11 reports a misspelt subcommand only as "A subcommand is required": name it
   const std::string first = argc > 1 ? argv[1] : "";
   const auto named = app.get_subcommands([&](const CLI::App* command) { return command->get_name() == first; });
   if (!first.empty() && first[0] != '-' && named.empty()) {
-    fmt::print(stderr, "metriplex: unknown subcommand '{}' (choose run, compare or bench; see --help)\n", first);
+    fmt::print(stderr, "metriplex: unknown subcommand '{}' (choose run, compare, bench or plot; see --help)\n", first);
     return kExitInvalidInput;
   }
   try {
@@ -127,6 +133,11 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return runCommand(request);
     if (compare->parsed()) return compareCommand(request, splitNames(integrators));
+    if (plot->parsed()) {
+      for (const std::filesystem::path& picture : renderHistoryPlots(plotDirectory))
+        fmt::print("{}\n", picture.string());
+      return 0;
+    }
     bench.scene = request.scene;
     bench.tEnd = request.tEnd;
     bench.out = request.out;

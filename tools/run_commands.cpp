@@ -1,173 +1,41 @@
 // metriplex run and metriplex compare.
 #include "tools/commands.hpp"
-#include "tools/output/checkpoint_file.hpp"
-#include "tools/output/frames_csv.hpp"
-#include "tools/output/history_csv.hpp"
-#include "tools/output/solid_frames.hpp"
+#include "tools/session/run_session.hpp"
 
 #include "engine/core/input_error.hpp"
-#include "engine/stepping/method.hpp"
-#include "models/scene/scene_loader.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <cmath>
-#include <filesystem>
+#include <chrono>
 
 namespace mpx {
 
 namespace {
 
-// A run whose input has been fully validated: nothing is written before this exists.
-struct PreparedRun {
-  Method method;
-  CompiledScene scene;
-  MethodParameters parameters;
-  std::filesystem::path out;
-  double frameInterval = 0.0;  // bodies.csv, joints.csv and solid frames
-  CheckpointIdentity identity;
-  std::optional<LoopState> resume;  // --restart
-};
-
-struct RunResult {
-  std::string variable;
-  RunSummary summary;
-  std::filesystem::path history;
-};
-
-void checkPositive(std::optional<double> value, const char* option) {
-  if (value && !(*value > 0.0 && std::isfinite(*value)))
-    throw InputError(fmt::format("option {} must be a positive number, got {}", option, *value));
-}
-
-Method methodOrThrow(const std::string& name) {
-  const std::optional<Method> method = methodByName(name);
-  if (!method) throw InputError(fmt::format("unknown integrator '{}' (choose {})", name, kMethodNames));
-  return *method;
-}
-
-// Draws a progress bar on a terminal; silent when stderr is redirected.
+// Draws a progress bar with the time left (elapsed wall time extrapolated over the fraction
+// to go) on a terminal; silent when stderr is redirected.
 ProgressSink progressBar(const std::string& label) {
   if (!isatty(fileno(stderr))) return nullptr;
-  return [label](double fraction) {
+  const auto start = std::chrono::steady_clock::now();
+  return [label, start](double fraction) {
     const int width = 40, done = static_cast<int>(fraction * width);
-    fmt::print(stderr, "\r{} [{}{}] {:3.0f}%", label, std::string(done, '#'), std::string(width - done, ' '),
-               100 * fraction);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::string left = fraction > 0.0 && fraction < 1.0
+                                 ? fmt::format("  ETA {:.0f} s  ", elapsed * (1.0 - fraction) / fraction)
+                                 : fmt::format("  {:.1f} s      ", elapsed);
+    fmt::print(stderr, "\r{} [{}{}] {:3.0f}%{}", label, std::string(done, '#'), std::string(width - done, ' '),
+               100 * fraction, left);
     if (fraction >= 1.0) fmt::print(stderr, "\n");
   };
 }
 
-// --checkpoint-every and --restart: what checkpoints identify, and the state a restart
-// continues from (read and checked here, before anything is written).
-void prepareCheckpoints(const RunRequest& request, PreparedRun& run) {
-  if (request.checkpointEvery < 0)
-    throw InputError(
-        fmt::format("option --checkpoint-every must be 0 (none) or more, got {}", request.checkpointEvery));
-  if (run.method.isIda() && (request.checkpointEvery > 0 || !request.restart.empty()))
-    throw InputError(
-        "options --checkpoint-every and --restart: integrator 'ida' cannot be checkpointed (its multistep history "
-        "cannot be saved and restored through SUNDIALS' interface); use a one-step integrator");
-  const MethodParameters& p = run.parameters;
-  const bool tolerances = p.adaptive;
-  run.identity = {run.scene.name,
-                  hashOfFile(request.scene),
-                  run.method.name,
-                  p.adaptive,
-                  run.scene.model->layout().total(),
-                  p.dt,
-                  tolerances ? p.relativeTolerance : 0.0,
-                  tolerances ? p.absoluteTolerance : 0.0,
-                  tolerances ? p.outputInterval : 0.0};
-  if (request.restart.empty()) return;
-  run.resume = readCheckpoint(request.restart, run.identity);
-  if (!(run.resume->time < p.tEnd))
-    throw InputError(fmt::format("option --restart: the checkpoint is at t = {:.17g}, not before t_end = {:.17g}",
-                                 run.resume->time, p.tEnd));
-}
-
-// The default output directory is out/<scene>-<outSuffix>, or out/<scene>-<integrator> when
-// outSuffix is empty.
-PreparedRun prepare(const RunRequest& request, const std::string& outSuffix) {
-  checkPositive(request.dt, "--dt");
-  checkPositive(request.tEnd, "--t-end");
-  checkPositive(request.relativeTolerance, "--rtol");
-  checkPositive(request.absoluteTolerance, "--atol");
-  checkPositive(request.outputStep, "--dt-out");
-  if (request.maxOrder < 1 || request.maxOrder > 5)
-    throw InputError(fmt::format("option --max-order must be 1 to 5, got {}", request.maxOrder));
-  std::optional<Method> method;
-  if (!request.integrator.empty()) method = methodOrThrow(request.integrator);
-  CompiledScene scene = loadScene(request.scene, method ? method->thermalVariable : std::nullopt);
-  if (!method) method = methodOrThrow(scene.settings.integrator);
-  checkMethodSupports(*method, *scene.model, request.scene);
-
-  MethodParameters parameters;
-  parameters.dt = request.dt.value_or(scene.settings.dt);
-  parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
-  parameters.newton = scene.settings.newton;
-  parameters.adaptive = request.adaptive || scene.settings.adaptive || method->adaptive;
-  const double sceneAtol = scene.settings.absoluteTolerance;
-  parameters.relativeTolerance = request.relativeTolerance.value_or(scene.settings.relativeTolerance);
-  parameters.absoluteTolerance = request.absoluteTolerance.value_or(
-      request.relativeTolerance || sceneAtol == 0.0 ? parameters.relativeTolerance : sceneAtol);
-  parameters.outputInterval = request.frameInterval.value_or(0.0);
-  parameters.maxOrder = request.maxOrder;
-  parameters.sundialsKlu = request.sundialsKlu;
-  if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
-  checkStepCount(parameters.tEnd, parameters.dt,
-                 method->isIda() ? "options --t-end and --dt-out" : "options --t-end and --dt");
-  std::filesystem::path out =
-      request.out.empty()
-          ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
-          : std::filesystem::path(request.out);
-  checkPositive(request.frameInterval, "--output-interval");
-  PreparedRun run{*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0), {}, {}};
-  prepareCheckpoints(request, run);
-  return run;
-}
-
-// Checkpoints of `metriplex run`, under the output directory.
-constexpr const char* kCheckpointFile = "checkpoint.txt";
-
-// Runs and writes the outputs; with `checkpoints`, a one-step run writes DIR/checkpoint.txt
-// every `checkpointEvery` steps and at a stop request, and continues from run.resume if set.
-RunResult execute(const PreparedRun& run, bool checkpoints = false, int checkpointEvery = 0) {
-  std::error_code error;
-  std::filesystem::create_directories(run.out, error);
-  if (error)
-    throw InputError(
-        fmt::format("option --out: cannot create the directory {}: {}", run.out.string(), error.message()));
-  HistoryCsv history(run.out, run.scene);
-  FramesCsv frames(run.out, run.scene, run.frameInterval);
-  SolidFrames solids(run.out, run.scene, run.frameInterval);
-  RunResult result{
-      run.scene.model->thermalVariable() == ThermalVariable::Entropy ? "entropy" : "temperature", {}, history.path()};
-  MethodParameters parameters = run.parameters;
-  if (!run.method.isIda() && checkpoints) {
-    parameters.checkpoints.every = checkpointEvery;
-    parameters.checkpoints.resume = run.resume ? &*run.resume : nullptr;
-    // a checkpoint that cannot be written (a full disk) is a warning: the run and its outputs go on
-    parameters.checkpoints.write = [&](const LoopState& state) {
-      try {
-        writeCheckpoint((run.out / kCheckpointFile).string(), run.identity, state);
-      } catch (const std::runtime_error& error) {
-        fmt::print(stderr, "metriplex: warning: no checkpoint after step {}: {}\n", state.step, error.what());
-      }
-    };
-  }
-  result.summary = runMethod(
-      *run.scene.model, run.method, parameters,
-      [&](const StepRecord& r) {
-        history.write(r);
-        frames.write(r);
-        solids.write(r);
-      },
-      progressBar(run.scene.name + " " + run.method.name));
-  history.finish(result.summary);
-  frames.finish();
-  solids.finish();
-  return result;
+RunOutputs runOutputs(const PreparedRun& run, bool checkpoints, int checkpointEvery) {
+  RunOutputs outputs;
+  outputs.checkpoints = checkpoints;
+  outputs.checkpointEvery = checkpointEvery;
+  outputs.progress = progressBar(run.scene.name + " " + run.method.name);
+  return outputs;
 }
 
 double perStep(long count, int steps) { return steps ? static_cast<double>(count) / steps : 0.0; }
@@ -175,7 +43,7 @@ double perStep(long count, int steps) { return steps ? static_cast<double>(count
 void printSummary(const RunResult& r, const RunRequest& request, const PreparedRun& run) {
   const RunSummary& s = r.summary;
   fmt::print("metriplex run {} --integrator {}{} (thermal variable: {})\n", request.scene, run.method.name,
-             run.parameters.adaptive && !run.method.isIda() ? " --adaptive" : "", r.variable);
+             run.parameters.adaptive && !run.method.isIda() ? " --adaptive" : "", run.thermalVariable());
   fmt::print("  steps                    {}{}\n", s.steps, s.ida ? " (output times)" : "");
   fmt::print("  newton iterations        {} ({:.2f} per step)\n", s.newtonIterations,
              perStep(s.newtonIterations, s.steps));
@@ -208,8 +76,8 @@ void printSummary(const RunResult& r, const RunRequest& request, const PreparedR
 }  // namespace
 
 int runCommand(const RunRequest& request) {
-  const PreparedRun run = prepare(request, "");
-  const RunResult result = execute(run, true, request.checkpointEvery);
+  const PreparedRun run = prepareRun(request);
+  const RunResult result = executeRun(run, runOutputs(run, true, request.checkpointEvery));
   printSummary(result, request, run);
   if (result.summary.interrupted) {
     fmt::print(stderr, "metriplex: interrupted after step {} (t = {:.9g}); history kept in {}{}\n",
@@ -232,7 +100,7 @@ int compareCommand(const RunRequest& base, const std::vector<std::string>& integ
     RunRequest request = base;
     request.integrator = name;
     request.out.clear();
-    runs.push_back(prepare(request, "compare"));
+    runs.push_back(prepareRun(request, "compare"));
   }
   const std::filesystem::path root = base.out.empty() ? runs.front().out : std::filesystem::path(base.out);
   fmt::print("{:<16} {:>8} {:>12} {:>10} {:>16} {:>16}  {}\n", "integrator", "steps", "newton/step", "wall [s]",
@@ -240,7 +108,7 @@ int compareCommand(const RunRequest& base, const std::vector<std::string>& integ
   // a blow-up is a finding here, not an error
   for (PreparedRun& run : runs) {
     run.out = root / run.method.name;
-    const RunResult r = execute(run);
+    const RunResult r = executeRun(run, runOutputs(run, false, 0));
     const RunSummary& s = r.summary;
     const std::string status =
         s.interrupted ? fmt::format("interrupted after step {} (t = {:.6g})", s.steps, s.interruptedTime)

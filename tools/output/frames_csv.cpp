@@ -7,10 +7,9 @@
 namespace mpx {
 
 FramesCsv::FramesCsv(const std::filesystem::path& directory, const CompiledScene& scene, double interval)
-    : scene_(scene), schedule_(interval) {
+    : scene_(scene), schedule_(interval), sampler_(scene) {
   if (!scene.bodies.empty()) open(bodies_, directory / "bodies.csv", "time,body,x,y,z,qw,qx,qy,qz");
   if (!scene.joints.empty()) open(joints_, directory / "joints.csv", "time,joint,position,velocity");
-  for (const JointCoordinate& joint : scene.joints) jointPositions_.push_back(joint.initialPosition());
 }
 
 FramesCsv::~FramesCsv() {
@@ -28,20 +27,17 @@ void FramesCsv::open(Output& output, const std::filesystem::path& path, const ch
 
 void FramesCsv::write(const StepRecord& record) {
   if (!schedule_.due(record.time)) return;
-  const double* z = record.state->data();
-  for (const BodyFrame& body : scene_.bodies) {
-    Eigen::Matrix3d directors;
-    for (int i = 0; i < 3; ++i) directors.col(i) = Eigen::Map<const Vec3>(z + body.firstPositionDof + 3 + 3 * i);
-    const Eigen::Quaterniond q(directors * body.directorsToBody);
+  sampler_.sample(record.state->data());
+  for (std::size_t b = 0; b < scene_.bodies.size(); ++b) {
+    const BodyPose& pose = sampler_.bodies()[b];
+    const Eigen::Quaterniond& q = pose.orientation;
     fmt::print(bodies_.file, "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", record.time,
-               body.name, z[body.firstPositionDof], z[body.firstPositionDof + 1], z[body.firstPositionDof + 2], q.w(),
-               q.x(), q.y(), q.z());
+               scene_.bodies[b].name, pose.position.x(), pose.position.y(), pose.position.z(), q.w(), q.x(), q.y(),
+               q.z());
   }
-  for (std::size_t j = 0; j < scene_.joints.size(); ++j) {
-    jointPositions_[j] = scene_.joints[j].position(z, jointPositions_[j]);
-    fmt::print(joints_.file, "{:.17g},{},{:.17g},{:.17g}\n", record.time, scene_.joints[j].name(), jointPositions_[j],
-               scene_.joints[j].velocity(z));
-  }
+  for (std::size_t j = 0; j < scene_.joints.size(); ++j)
+    fmt::print(joints_.file, "{:.17g},{},{:.17g},{:.17g}\n", record.time, scene_.joints[j].name(),
+               sampler_.joints()[j].position, sampler_.joints()[j].velocity);
 }
 
 void FramesCsv::finish() {

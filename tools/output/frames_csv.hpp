@@ -4,6 +4,7 @@
 // output time and body or joint. Written as .part files and renamed when the run ends.
 #include "engine/stepping/simulation.hpp"
 #include "models/scene/scene_loader.hpp"
+#include "tools/output/frame_sampler.hpp"
 #include "tools/output/output_schedule.hpp"
 
 #include <cstdio>
@@ -31,8 +32,8 @@ class FramesCsv {
 
   const CompiledScene& scene_;
   OutputSchedule schedule_;
+  FrameSampler sampler_;
   Output bodies_, joints_;
-  std::vector<double> jointPositions_;  // last written, to unwrap angles
 };
 
 }  // namespace mpx

@@ -1,11 +1,8 @@
 #pragma once
 // DIR/history.csv: one row per step. Written to history.csv.part and renamed when the run
 // ends, so an interrupted run never leaves a file that looks complete; a solver failure is
-// kept up to the last good step and marked by a final comment line. Entropy production is the
-// entropy change not brought in through boundaries; thermal solids add their temperature range.
-#include "engine/core/model.hpp"
-#include "engine/stepping/simulation.hpp"
-#include "models/scene/scene_loader.hpp"
+// kept up to the last good step and marked by a final comment line. Columns: HistoryColumns.
+#include "tools/output/history_columns.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -27,7 +24,8 @@ class HistoryCsv {
   std::filesystem::path path() const { return finalPath_; }
 
  private:
-  std::vector<const SolidPlacement*> thermalSolids_;
+  HistoryColumns columns_;
+  std::vector<double> values_;
   std::FILE* file_ = nullptr;
   std::filesystem::path partPath_, finalPath_;
 };
