@@ -2,6 +2,7 @@
 // with every option of `metriplex run`, and get its history, summary and frames as numpy
 // arrays and dicts. The run itself is tools/session's, as for the command line; the history
 // columns are history.csv's (HistoryColumns), the frames bodies.csv's and joints.csv's.
+#include "tools/output/element_budget.hpp"
 #include "tools/output/frame_sampler.hpp"
 #include "tools/output/history_columns.hpp"
 #include "tools/output/output_schedule.hpp"
@@ -26,8 +27,11 @@ struct Columns {
   std::vector<std::string> names;
   std::vector<std::vector<double>> values;
   explicit Columns(std::vector<std::string> columnNames) : names(std::move(columnNames)), values(names.size()) {}
-  void append(std::initializer_list<double> row) {
-    std::size_t i = 0;
+  // A time and the values after it, one per remaining column.
+  template <class Values>
+  void append(double time, const Values& row) {
+    values[0].push_back(time);
+    std::size_t i = 1;
     for (double value : row) values[i++].push_back(value);
   }
   py::dict toDict() const {
@@ -38,12 +42,12 @@ struct Columns {
   }
 };
 
-// What a run hands back: the history, bodies' poses and joints' coordinates at the output
-// times of --output-interval, and the summary as summary.json has it.
+// What a run hands back: the history, bodies' poses, joints' coordinates and the budget per
+// element at the output times of --output-interval, and the summary as summary.json has it.
 struct Recording {
   std::vector<std::string> historyNames;
   std::vector<std::vector<double>> history;
-  std::map<std::string, Columns> bodies, joints;
+  std::map<std::string, Columns> bodies, joints, budget;
   std::string summary;
 };
 
@@ -68,6 +72,13 @@ Recording record(const RunRequest& request) {
     recording.bodies.emplace(body.name, Columns({"time", "x", "y", "z", "qw", "qx", "qy", "qz"}));
   for (const JointCoordinate& joint : run.scene.joints)
     recording.joints.emplace(joint.name(), Columns({"time", "position", "velocity"}));
+  std::optional<ElementBudget> budget;
+  if (request.budget) {
+    budget.emplace(run.scene);
+    std::vector<std::string> names{"time"};
+    names.insert(names.end(), ElementBudget::columnNames().begin(), ElementBudget::columnNames().end());
+    for (const std::string& group : budget->groups()) recording.budget.emplace(group, Columns(names));
+  }
   FrameSampler sampler(run.scene);
   OutputSchedule schedule(run.frameInterval);
   std::vector<double> values;
@@ -85,11 +96,15 @@ Recording record(const RunRequest& request) {
       const BodyPose& pose = sampler.bodies()[b];
       const Eigen::Quaterniond& q = pose.orientation;
       recording.bodies.at(run.scene.bodies[b].name)
-          .append({step.time, pose.position.x(), pose.position.y(), pose.position.z(), q.w(), q.x(), q.y(), q.z()});
+          .append(step.time,
+                  std::array{pose.position.x(), pose.position.y(), pose.position.z(), q.w(), q.x(), q.y(), q.z()});
     }
     for (std::size_t j = 0; j < run.scene.joints.size(); ++j)
       recording.joints.at(run.scene.joints[j].name())
-          .append({step.time, sampler.joints()[j].position, sampler.joints()[j].velocity});
+          .append(step.time, std::array{sampler.joints()[j].position, sampler.joints()[j].velocity});
+    if (!budget) return;
+    const std::vector<ElementBudget::Row>& rows = budget->rows(step);
+    for (std::size_t g = 0; g < rows.size(); ++g) recording.budget.at(budget->groups()[g]).append(step.time, rows[g]);
   };
   const RunResult result = executeRun(run, outputs);
   recording.summary = summaryJson(run, result.summary);
@@ -113,7 +128,7 @@ AttributeValue attributeOf(const std::string& name, const py::handle& value) {
 py::object run(const py::object& scene, const std::string& integrator, std::optional<double> dt,
                std::optional<double> tEnd, const std::string& out, std::optional<double> outputInterval, bool adaptive,
                std::optional<double> rtol, std::optional<double> atol, int maxOrder, bool sundialsKlu,
-               std::optional<double> dtOut, int checkpointEvery, const std::string& restart) {
+               std::optional<double> dtOut, int checkpointEvery, const std::string& restart, bool budget) {
   RunRequest request;
   if (py::isinstance<SceneSpec>(scene)) {
     request.spec = &scene.cast<const SceneSpec&>();
@@ -134,6 +149,7 @@ py::object run(const py::object& scene, const std::string& integrator, std::opti
   request.outputStep = dtOut;
   request.checkpointEvery = checkpointEvery;
   request.restart = restart;
+  request.budget = budget;
   const Recording recording = record(request);
 
   py::dict history;
@@ -142,7 +158,7 @@ py::object run(const py::object& scene, const std::string& integrator, std::opti
         py::array_t<double>(recording.history[i].size(), recording.history[i].data());
   const py::object summary = py::module_::import("json").attr("loads")(recording.summary);
   return py::module_::import("metriplex")
-      .attr("Result")(history, summary, toDict(recording.bodies), toDict(recording.joints));
+      .attr("Result")(history, summary, toDict(recording.bodies), toDict(recording.joints), toDict(recording.budget));
 }
 
 ThermalVariable thermalVariableNamed(const std::string& name) {
@@ -207,7 +223,7 @@ PYBIND11_MODULE(_metriplex, module) {
              py::arg("t_end") = py::none(), py::arg("out") = "", py::arg("output_interval") = py::none(),
              py::arg("adaptive") = false, py::arg("rtol") = py::none(), py::arg("atol") = py::none(),
              py::arg("max_order") = 5, py::arg("sundials_klu") = false, py::arg("dt_out") = py::none(),
-             py::arg("checkpoint_every") = 0, py::arg("restart") = "",
+             py::arg("checkpoint_every") = 0, py::arg("restart") = "", py::arg("budget") = false,
              "Run a scene file (str or path) or a Scene with the options of `metriplex run` (docs/python.md). "
              "Writes files only into `out` when given. Raises InputError (a ValueError) on invalid input.");
 }

@@ -81,8 +81,12 @@ int main(int argc, char** argv) {
   run->add_option("--restart", request.restart,
                   "one-step integrators: continue the run from a checkpoint file; its history starts at the "
                   "checkpoint's step");
+  run->add_flag(
+      "--budget", request.budget,
+      "eem, midpoint, trapezoidal: write DIR/budget.csv and budget.png, energy and entropy per scene element");
   run->add_option("--output-interval", request.frameInterval,
-                  "interval of bodies.csv and joints.csv rows and of solid frames (.vtu) (default: every history row)");
+                  "interval of bodies.csv, joints.csv and budget.csv rows and of solid frames (.vtu) (default: every "
+                  "history row)");
 
   CLI::App* compare = app.add_subcommand("compare",
                                          "run one scene with several integrators and tabulate "

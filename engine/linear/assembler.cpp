@@ -63,6 +63,7 @@ Assembler::Assembler(const Model& model) {
   localResidual_.assign(slots * largest, 0.0);
   localTangent_.assign(slots * largest * largest, 0.0);
   localFlows_.resize(slots);
+  componentFlows_.resize(components.size() + 1);
   for (std::size_t b = 0; b < slots; ++b)
     locals_.push_back({0, localResidual_.data() + b * largest, localTangent_.data() + b * largest * largest});
 }
@@ -71,6 +72,7 @@ void Assembler::clear() {
   residual_.setZero();
   std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
   flows_ = Flows{};
+  std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }
 
 void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
@@ -90,12 +92,15 @@ void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double valu
   const double reaction = residual_[p.dof];
   // a prescribed temperature's reaction is the heat it supplies, which brings entropy at that
   // temperature (`conjugate` holds it); a prescribed velocity's reaction does work
+  Flows crossed;
   if (p.kind == PrescribedKind::Temperature) {
-    flows_.boundaryHeat += reaction;
-    flows_.boundaryEntropy += reaction / conjugate;
+    crossed.boundaryHeat = reaction;
+    crossed.boundaryEntropy = reaction / conjugate;
   } else {
-    flows_.externalWork += reaction * conjugate;
+    crossed.externalWork = reaction * conjugate;
   }
+  flows_ += crossed;
+  componentFlows_.back() += crossed;
   double* values = tangent_.valuePtr();
   for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
   values[prescribedDiagonal_[k]] = diagonal;

@@ -155,21 +155,26 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   const int n = model.layout().total();
   Eigen::VectorXd next(n), half(n), fullStep(n);
   Flows crossed = reporter.last().crossed;
+  // slots of the attempts: the full step, the first half, the step taken
+  enum Attempt { kFull, kFirstHalf, kTaken };
+  ComponentFlows byComponent(model, options.componentFlows, 3);
   int accepted = reporter.last().step;
   char newtonFailure[sizeof StepOutcome::failure] = "";
   // one step of the scheme, counted in the summary
-  auto attempt = [&](const Eigen::VectorXd& from, double t, double dt, Eigen::VectorXd& to, StepOutcome& outcome) {
-    outcome = integrator.advance(from, t, dt, to);
+  auto attempt = [&](const Eigen::VectorXd& from, double t, double dt, Eigen::VectorXd& to, StepOutcome& outcome,
+                     Attempt slot) {
+    outcome = integrator.advance(from, t, dt, to, byComponent.slot(slot));
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
     summary.factorizations += outcome.factorizations;
     if (!outcome.converged) std::snprintf(newtonFailure, sizeof newtonFailure, "%s", outcome.failure);
     return outcome.converged;
   };
-  auto accept = [&](Eigen::VectorXd& state, double time, double dt, const StepOutcome& outcome) {
+  auto accept = [&](Eigen::VectorXd& state, double time, double dt, const StepOutcome& outcome, Attempt slot) {
     reporter.state().swap(state);
     crossed += outcome.energy;
-    return reporter.report(++accepted, time, dt, crossed, outcome.iterations, outcome.cutbacks);
+    byComponent.accept(slot);
+    return reporter.report(++accepted, time, dt, crossed, outcome.iterations, outcome.cutbacks, byComponent.crossed());
   };
 
   double proposed = options.dt;
@@ -199,11 +204,11 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     StepOutcome fullOutcome, firstHalfOutcome, stepOutcome;
     const bool doubling = !localError.hasHistory();
     if (doubling) {
-      if (attempt(reporter.state(), t, dt, fullStep, fullOutcome) &&
-          attempt(reporter.state(), t, 0.5 * dt, half, firstHalfOutcome) &&
-          attempt(half, t + 0.5 * dt, 0.5 * dt, next, stepOutcome))
+      if (attempt(reporter.state(), t, dt, fullStep, fullOutcome, kFull) &&
+          attempt(reporter.state(), t, 0.5 * dt, half, firstHalfOutcome, kFirstHalf) &&
+          attempt(half, t + 0.5 * dt, 0.5 * dt, next, stepOutcome, kTaken))
         error = localError.ofHalving(next, fullStep);
-    } else if (attempt(reporter.state(), t, dt, next, stepOutcome)) {
+    } else if (attempt(reporter.state(), t, dt, next, stepOutcome, kTaken)) {
       error = localError.ofStep(tNew, next);
     }
 
@@ -223,10 +228,10 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     // a stop request after the first half still takes the second, so that a checkpoint
     // falls where a step is complete
     if (doubling) {
-      if (!accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome) && summary.failed) break;
+      if (!accept(half, t + 0.5 * dt, 0.5 * dt, firstHalfOutcome, kFirstHalf) && summary.failed) break;
       localError.accept(t + 0.5 * dt, reporter.state());
     }
-    const bool goOn = accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome);
+    const bool goOn = accept(next, tNew, doubling ? 0.5 * dt : dt, stepOutcome, kTaken);
     if (summary.failed) break;
     // the next step from the last one taken and its own error (a half step of a doubling has
     // half the pair's); a step shortened to land may be followed by one up to the size

@@ -83,6 +83,8 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance && residualNorm <= settings_.residualTolerance) {
       outcome.energy += system.flows() * dt;
+      if (byComponent_)
+        for (std::size_t c = 0; c < byComponent_->size(); ++c) (*byComponent_)[c] += system.componentFlows()[c] * dt;
       return true;
     }
     if (iteration == settings_.maxIterations)
@@ -166,8 +168,11 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
          advanceLevel(half, t + 0.5 * dt, 0.5 * dt, level + 1, zNew, outcome);
 }
 
-StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew) {
+StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew,
+                                std::vector<Flows>* byComponent) {
   StepOutcome outcome;
+  byComponent_ = byComponent;
+  if (byComponent) std::fill(byComponent->begin(), byComponent->end(), Flows{});
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
   if (outcome.converged) {
     lastStart_ = z;

@@ -56,8 +56,10 @@ class Integrator {
   Integrator(const Model& model, Scheme scheme, NewtonSettings settings);
 
   // Advance state z at time t by dt into zNew, halving the step up to maxCutbacks times
-  // when Newton fails. Allocates nothing.
-  StepOutcome advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew);
+  // when Newton fails. Allocates nothing. With `byComponent` (sized as
+  // Assembler::componentFlows()), the step's flows per component go there as well.
+  StepOutcome advance(const Eigen::VectorXd& z, double t, double dt, Eigen::VectorXd& zNew,
+                      std::vector<Flows>* byComponent = nullptr);
 
   // Checkpoint: save the predictor into `out` and start the linear solver afresh
   // (engine/stepping/loop_state.hpp says why). Resume: take the predictor from a checkpoint,
@@ -97,6 +99,7 @@ class Integrator {
   // predictor: the last accepted step, lastStart_ at lastTime_ to lastEnd_ over lastDt_
   Eigen::VectorXd lastStart_, lastEnd_;
   double lastTime_ = NAN, lastDt_ = 0.0;
+  std::vector<Flows>* byComponent_ = nullptr;  // of the advance under way, if asked for
 };
 
 }  // namespace mpx

@@ -51,7 +51,7 @@ RunSummary runMethod(const Model& model, const Method& method, const MethodParam
   if (method.isIda())
     return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.sundialsKlu, p.dt, p.tEnd}, sink,
                        progress);
-  const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton, p.checkpoints};
+  const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton, p.checkpoints, p.componentFlows};
   if (p.adaptive || method.adaptive)
     return simulateAdaptive(model, options, {p.relativeTolerance, p.absoluteTolerance, p.outputInterval}, sink,
                             progress);

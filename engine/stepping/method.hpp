@@ -38,6 +38,7 @@ struct MethodParameters {
   int maxOrder = 5;                 // IDA
   bool sundialsKlu = false;         // IDA: SUNDIALS' KLU rather than Metriplex's sparse LU
   Checkpointing checkpoints;        // one-step schemes only (IDA's multistep history cannot be saved)
+  bool componentFlows = false;      // one-step schemes: StepRecord::componentCrossed
 };
 
 // Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a

@@ -118,7 +118,8 @@ std::string describeNonFinite(const Model& model, const Eigen::VectorXd& z, cons
 void requestStop() noexcept { stopRequest = true; }
 bool stopRequested() noexcept { return stopRequest; }
 
-bool RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks) {
+bool RunReporter::report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks,
+                         const std::vector<Flows>* componentCrossed) {
   model_.measure(state_, measures_);
   // a non-finite state or output ends the run here, before it reaches the history
   if (!state_.allFinite() || !finite(measures_) || !finite(crossed)) {
@@ -134,6 +135,7 @@ bool RunReporter::report(int step, double time, double dt, const Flows& crossed,
   record_.crossed = crossed;
   record_.newtonIterations = newtonIterations;
   record_.cutbacks = cutbacks;
+  record_.componentCrossed = componentCrossed;
   sink_(record_);
 
   // conservation figures: the energy balance against t = 0, the smallest entropy production of a step
@@ -161,6 +163,18 @@ void RunReporter::finish() {
   summary_.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+ComponentFlows::ComponentFlows(const Model& model, bool kept, int slots) : kept_(kept) {
+  if (!kept) return;
+  const std::size_t entries = model.components().size() + 1;  // and the prescribed motions
+  slots_.assign(slots, std::vector<Flows>(entries));
+  crossed_.assign(entries, Flows{});
+}
+
+void ComponentFlows::accept(int k) {
+  if (!kept_) return;
+  for (std::size_t c = 0; c < crossed_.size(); ++c) crossed_[c] += slots_[k][c];
+}
+
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink, const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
@@ -172,11 +186,12 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
   if (checkpoints.resume) integrator.resume(*checkpoints.resume);
   Eigen::VectorXd next(reporter.state().size());
   Flows crossed = reporter.last().crossed;
+  ComponentFlows byComponent(model, options.componentFlows, 1);
   CheckpointSchedule schedule(checkpoints, reporter.last().step);
   for (int n = reporter.last().step + 1; n <= steps; ++n) {
     const double t = reporter.last().time;
     const double dt = std::min(options.dt, options.tEnd - t);
-    const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next);
+    const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next, byComponent.slot(0));
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
     summary.factorizations += outcome.factorizations;
@@ -189,8 +204,9 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     }
     reporter.state().swap(next);
     crossed += outcome.energy;
-    const bool goOn =
-        reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations, outcome.cutbacks);
+    byComponent.accept(0);
+    const bool goOn = reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations,
+                                      outcome.cutbacks, byComponent.crossed());
     if (summary.failed) break;
     if (schedule.due(n, summary.interrupted)) {
       LoopState saved;

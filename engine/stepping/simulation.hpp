@@ -20,6 +20,7 @@ struct RunOptions {
   double tEnd = 0.0;
   NewtonSettings newton;
   Checkpointing checkpoints;
+  bool componentFlows = false;  // report the flows per component too (StepRecord::componentCrossed)
 };
 
 // What one step reports; energies that crossed the boundary are accumulated since t = 0.
@@ -33,6 +34,25 @@ struct StepRecord {
   int newtonIterations = 0;
   int cutbacks = 0;
   double initialEntropy = 0.0;  // S at t = 0, against which entropy production is counted
+  // `crossed` per component in the model's order, then the prescribed motions' reactions;
+  // set when the run keeps them (RunOptions::componentFlows)
+  const std::vector<Flows>* componentCrossed = nullptr;
+};
+
+// The flows of a one-step run per component, summed since t = 0 over the accepted steps: each
+// attempt gets its own slot from Integrator::advance, an accepted attempt's slot is added.
+// Without `kept` it holds nothing and hands out null slots.
+class ComponentFlows {
+ public:
+  ComponentFlows(const Model& model, bool kept, int slots);
+  std::vector<Flows>* slot(int k) { return kept_ ? &slots_[k] : nullptr; }
+  void accept(int k);
+  const std::vector<Flows>* crossed() const { return kept_ ? &crossed_ : nullptr; }
+
+ private:
+  bool kept_;
+  std::vector<std::vector<Flows>> slots_;
+  std::vector<Flows> crossed_;
 };
 
 // SUNDIALS IDA's counters for a run (see engine/ida_simulation.hpp).
@@ -123,7 +143,8 @@ class RunReporter {
   // flows are not finite (a failure in the summary, nothing handed to the sink; state() then
   // holds the rejected state), or a stop was requested before tEnd (the step reported, the
   // summary marked interrupted).
-  bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks);
+  bool report(int step, double time, double dt, const Flows& crossed, int newtonIterations, int cutbacks,
+              const std::vector<Flows>* componentCrossed = nullptr);
   // Record the wall time since construction in the summary.
   void finish();
   // The last report and the summary's running figures, into a checkpoint.

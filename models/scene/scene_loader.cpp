@@ -7,6 +7,7 @@
 #include "models/scene/xml_scene.hpp"
 
 #include <filesystem>
+#include <map>
 
 namespace mpx {
 
@@ -85,12 +86,17 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
   build.allocate(layoutOf(demands, firsts));
 
   // pass 2: every element builds from the dofs it declared, and takes all of them
+  std::map<const Component*, std::string> elementOf;
   for (std::size_t k = 0; k < scene.elements.size(); ++k) {
     ElementReader in(scene.elements[k]);
     DofRange dofs(build.layout, firsts[k], demands[k]);
+    const std::size_t before = build.components.size();
     kinds[k]->build(in, build, dofs);
     in.finish();
     dofs.checkAllTaken(in.where() + ": <" + in.tag() + ">");
+    const std::string* name = scene.elements[k].find("name");
+    for (std::size_t c = before; c < build.components.size(); ++c)
+      elementOf[build.components[c].get()] = name ? *name : scene.elements[k].tag;
   }
   if (build.layout.total() == 0)
     throw InputError(SourceLocation{scene.label, scene.line, 0}.describe() +
@@ -101,13 +107,17 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
   auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
                                        build.thermalNodeNames, build.state, build.scale,
                                        std::move(build.prescribedMotions), std::move(build.loadBreakpoints));
+  // the model evaluates couplings last: its order, not the build's
+  std::vector<std::string> componentElements;
+  for (const auto& component : model->components()) componentElements.push_back(elementOf.at(component.get()));
   return {scene.name,
           scene.settings,
           std::move(model),
           std::move(build.bodyFrames),
           std::move(build.jointCoordinates),
           std::move(build.solids),
-          std::move(redundant)};
+          std::move(redundant),
+          std::move(componentElements)};
 }
 
 SceneSpec readScene(const std::string& path) {

@@ -22,6 +22,9 @@ struct CompiledScene {
   std::vector<JointCoordinate> joints;  // revolute and prismatic joints, for joints.csv
   std::vector<SolidPlacement> solids;
   std::vector<RedundantConditions> redundantConditions;  // their multipliers are held at zero
+  // the scene element (its name, else its tag) each of the model's components came from, in
+  // the model's order: what a per-element budget sums over
+  std::vector<std::string> componentElements;
 };
 
 // Throws InputError (file, line, element, what is wrong) on any invalid input. When

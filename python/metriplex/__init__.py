@@ -15,12 +15,14 @@ class Result:
     """One run: history maps every history.csv column to a numpy array (one entry per step);
     summary is summary.json as a dict (steps, newton_iterations, wall_seconds,
     max_relative_energy_drift, status, ...); bodies and joints map each rigid body and each
-    revolute or prismatic joint to a dict of numpy arrays named as in bodies.csv and joints.csv."""
+    revolute or prismatic joint to a dict of numpy arrays named as in bodies.csv and joints.csv;
+    budget (run with budget=True) maps each scene element to its columns of budget.csv."""
 
     history: dict
     summary: dict
     bodies: dict
     joints: dict
+    budget: dict
 
     @property
     def ok(self):

@@ -130,3 +130,14 @@ def test_the_gil_is_released_during_a_run():
     worker.join()
     assert ended["end"] - ended["start"] > 0.2, "the run is too short for the test to mean anything"
     assert woke < ended["end"]
+
+
+def test_budget_per_element_sums_to_the_history():
+    r = metriplex.run(str(SCENES / "heated_thermo_spring.xml"), budget=True, t_end=5)
+    assert set(r.budget) >= {"bob", "spring"}
+    for column in ["energy", "entropy", "boundary_heat", "entropy_production"]:
+        total = sum(group[column] for group in r.budget.values())
+        scale = max(np.max(np.abs(group[column])) for group in r.budget.values())
+        np.testing.assert_allclose(total, r.history[column], rtol=0, atol=1e-12 * scale, err_msg=column)
+    with pytest.raises(metriplex.InputError, match="budget"):
+        metriplex.run(TWO_SPRINGS, integrator="ida", budget=True)

@@ -1,6 +1,7 @@
 #include "tools/session/run_session.hpp"
 
 #include "tools/output/atomic_file.hpp"
+#include "tools/output/budget_csv.hpp"
 #include "tools/output/frames_csv.hpp"
 #include "tools/output/history_csv.hpp"
 #include "tools/output/json_object.hpp"
@@ -101,6 +102,12 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
           ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
           : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
+  // IDA integrates the summed flows as quadratures; a restart has no flows per element to resume
+  if (request.budget && method->isIda())
+    throw InputError("option --budget: integrator 'ida' integrates only the total flows; use a one-step integrator");
+  if (request.budget && !request.restart.empty())
+    throw InputError("options --budget and --restart: a checkpoint holds no flows per element; run from t = 0");
+  parameters.componentFlows = request.budget;
   PreparedRun run{*method, std::move(scene), parameters, std::move(out), request.frameInterval.value_or(0.0), {}, {}};
   prepareCheckpoints(request, run);
   return run;
@@ -117,10 +124,12 @@ RunResult executeRun(const PreparedRun& run, const RunOutputs& outputs) {
   std::optional<HistoryCsv> history;
   std::optional<FramesCsv> frames;
   std::optional<SolidFrames> solids;
+  std::optional<BudgetCsv> budget;
   if (outputs.files) {
     history.emplace(run.out, run.scene);
     frames.emplace(run.out, run.scene, run.frameInterval);
     solids.emplace(run.out, run.scene, run.frameInterval);
+    if (run.parameters.componentFlows) budget.emplace(run.out, run.scene, run.frameInterval);
   }
   MethodParameters parameters = run.parameters;
   if (!run.method.isIda() && outputs.checkpoints) {
@@ -143,6 +152,7 @@ RunResult executeRun(const PreparedRun& run, const RunOutputs& outputs) {
           history->write(r);
           frames->write(r);
           solids->write(r);
+          if (budget) budget->write(r);
         }
         if (outputs.observe) outputs.observe(r);
       },
@@ -151,6 +161,7 @@ RunResult executeRun(const PreparedRun& run, const RunOutputs& outputs) {
   history->finish(result.summary);
   frames->finish();
   solids->finish();
+  if (budget) budget->finish();
   result.history = history->path();
   // like a checkpoint, a summary that cannot be written leaves the run's history standing
   try {
