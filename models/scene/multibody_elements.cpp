@@ -59,7 +59,7 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     build.state.segment<3>(phiRate + 3 + 3 * i) = angularVelocity.cross(directors.col(i));
   }
   build.keepPositionScale(position.norm());
-  build.points[name] = Endpoint{phi, phiRate, Vec3::Zero()};
+  build.points[name] = Endpoint::point(phi, phiRate);
   build.attachments[name] = Attachment{Attachment::Kind::Body, phi, position, directors};
   build.bodyFrames.push_back({name, phi, directors.transpose() * rotation});
   build.addComponent(std::make_unique<Inertia>(
