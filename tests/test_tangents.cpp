@@ -137,15 +137,36 @@ std::string bodyPointElements(ThermalVariable variable) {
     <actuator name="push" a="right" a_point="1.2 -0.1 0.1" b="bob" force="2" profile="ramp" start="0" end="2"/>)";
 }
 
+// A hinge and a slider each started beyond one of their stops (damped), the hinge's stops
+// heating a reservoir.
+std::string jointStops(ThermalVariable) {
+  return R"(<gravity g="0 0 -9.81"/>
+    <anchor name="ground" position="0 0 0"/>
+    <body name="arm" mass="1" inertia="0.01 0.09 0.09" position="0.5 0 0" angular_velocity="0 0.7 0"/>
+    <body name="slider" mass="0.5" inertia="0.02 0.03 0.04" position="1.2 0 0.1" velocity="0.2 0 -0.35"
+          angular_velocity="0 0.7 0"/>
+    <joint name="hinge" type="revolute" a="ground" b="arm" anchor="0 0 0" axis="0 1 0" coordinate="0.3"/>
+    <joint name="slide" type="prismatic" a="arm" b="slider" anchor="1.2 0 0.1" axis="1 0 0"
+           enforcement="penalty" stiffness="1e4"/>
+    <reservoir name="bearing" heat_capacity="2" reference_temperature="1" temperature="1.1"/>
+    <joint_force name="hinge_stops" joint="hinge" lower="-1" upper="0.25" limit_stiffness="500" limit_damping="20"
+                 heat_node="bearing"/>
+    <joint_force name="slide_stops" joint="slide" lower="0.02" upper="0.4" limit_stiffness="3e4"
+                 limit_damping="100" damping="0.1"/>)";
+}
+
 struct SceneBody {
   const char* name;
   std::string (*body)(ThermalVariable);
 };
 
-const SceneBody kScenes[] = {
-    {"spring_in_gravity", springInGravity},        {"maxwell_with_dampers", maxwellWithDampers},
-    {"thermo_spring_to_wall", thermoSpringToWall}, {"thermo_maxwell_chain", thermoMaxwellChain},
-    {"dissipative_joints", dissipativeJoints},     {"body_point_elements", bodyPointElements}};
+const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity},
+                             {"maxwell_with_dampers", maxwellWithDampers},
+                             {"thermo_spring_to_wall", thermoSpringToWall},
+                             {"thermo_maxwell_chain", thermoMaxwellChain},
+                             {"dissipative_joints", dissipativeJoints},
+                             {"body_point_elements", bodyPointElements},
+                             {"joint_stops", jointStops}};
 
 std::string variableName(ThermalVariable variable) {
   return variable == ThermalVariable::Temperature ? "temperature" : "entropy";
