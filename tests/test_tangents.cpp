@@ -112,6 +112,49 @@ std::string dissipativeJoints(ThermalVariable) {
                  heat_node="bearing"/>)";
 }
 
+// Every two-point element at points of two tumbling bodies and a mass, with an actuator: the
+// forces reach the centre and director rows through the points' body coordinates.
+std::string bodyPointElements(ThermalVariable variable) {
+  return R"(<gravity g="0 0 -1"/>
+    <body name="left" mass="2" inertia="0.2 0.3 0.4 0.03 -0.02 0.01" orientation="0.9 0.1 0.3 -0.2"
+          velocity="0.1 0.2 -0.1" angular_velocity="1 2 3"/>
+    <body name="right" mass="1.5" inertia="0.15 0.1 0.2" orientation="0.8 -0.3 0.1 0.5" position="1.2 0.1 -0.1"
+          velocity="-0.2 0 0.1" angular_velocity="-2 0.5 1" enforcement="penalty" stiffness="1e4"/>
+    <mass name="bob" mass="1" position="0.5 1 0" velocity="0 0 0.3"/>
+    <anchor name="wall" position="-1 0 0"/>
+    <spring name="spring" a="left" a_point="0.2 0.1 0.05" b="right" b_point="1 -0.05 0.1" stiffness="50"
+            rest_length="0.6"/>
+    <maxwell name="maxwell" a="bob" b="right" b_point="1.1 0 -0.15" stiffness="10" rest_length="1"
+             branch_stiffness="20" viscosity="0.5" viscous_elongation="0.05"/>
+    <damper name="damper" a="left" a_point="-0.1 0.15 0" b="right" b_point="1.3 0.2 -0.2" coefficient="0.8"/>
+    <thermo_spring name="thermo" a="wall" b="left" b_point="0.1 -0.2 0.1" stiffness="1" stiffness_slope="-0.2")" +
+         curvature(variable) + R"( coupling="0.5" rest_length="1" heat_capacity="1" reference_temperature="1"
+                   temperature="1"/>
+    <thermo_maxwell name="visco" a="left" a_point="0 0.2 -0.1" b="right" b_point="1.2 0.2 0" stiffness="1"
+                    coupling="0.5" rest_length="1" heat_capacity="1" reference_temperature="1" branch_stiffness="2"
+                    viscosity="1" viscosity_activation="0.5" viscous_strain="0.05" temperature="1.2"/>
+    <heat_link name="between" a="visco" b="thermo" conductivity="0.7"/>
+    <actuator name="push" a="right" a_point="1.2 -0.1 0.1" b="bob" force="2" profile="ramp" start="0" end="2"/>)";
+}
+
+// A hinge and a slider each started beyond one of their stops (damped), the hinge's stops
+// heating a reservoir.
+std::string jointStops(ThermalVariable) {
+  return R"(<gravity g="0 0 -9.81"/>
+    <anchor name="ground" position="0 0 0"/>
+    <body name="arm" mass="1" inertia="0.01 0.09 0.09" position="0.5 0 0" angular_velocity="0 0.7 0"/>
+    <body name="slider" mass="0.5" inertia="0.02 0.03 0.04" position="1.2 0 0.1" velocity="0.2 0 -0.35"
+          angular_velocity="0 0.7 0"/>
+    <joint name="hinge" type="revolute" a="ground" b="arm" anchor="0 0 0" axis="0 1 0" coordinate="0.3"/>
+    <joint name="slide" type="prismatic" a="arm" b="slider" anchor="1.2 0 0.1" axis="1 0 0"
+           enforcement="penalty" stiffness="1e4"/>
+    <reservoir name="bearing" heat_capacity="2" reference_temperature="1" temperature="1.1"/>
+    <joint_force name="hinge_stops" joint="hinge" lower="-1" upper="0.25" limit_stiffness="500" limit_damping="20"
+                 heat_node="bearing"/>
+    <joint_force name="slide_stops" joint="slide" lower="0.02" upper="0.4" limit_stiffness="3e4"
+                 limit_damping="100" damping="0.1"/>)";
+}
+
 struct SceneBody {
   const char* name;
   std::string (*body)(ThermalVariable);
@@ -121,7 +164,9 @@ const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity},
                              {"maxwell_with_dampers", maxwellWithDampers},
                              {"thermo_spring_to_wall", thermoSpringToWall},
                              {"thermo_maxwell_chain", thermoMaxwellChain},
-                             {"dissipative_joints", dissipativeJoints}};
+                             {"dissipative_joints", dissipativeJoints},
+                             {"body_point_elements", bodyPointElements},
+                             {"joint_stops", jointStops}};
 
 std::string variableName(ThermalVariable variable) {
   return variable == ThermalVariable::Temperature ? "temperature" : "entropy";

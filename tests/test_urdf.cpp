@@ -331,7 +331,7 @@ const std::vector<BadUrdf> kBadUrdfs = {
     {"FlatInertia",
      robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.01\" iyy=\"0.01\" izz=\"0.03\""), kHinge}),
      3,
-     {"<link name=\"arm\">", "triangle inequality"}},
+     {"<link name=\"arm\">", "triangle inequality", "balance_inertia"}},
     {"Mimic",
      robotWith({kWorld, kArm, linkWith("hand", "1", kBox), kHinge,
                 jointWith("wrist", "continuous", "arm", "hand", "<axis xyz=\"0 1 0\"/><mimic joint=\"hinge\"/>")}),
@@ -524,6 +524,111 @@ TEST_F(UrdfTest, UrdfFileRunsAsASceneWithDefaults) {
   ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
   const std::string history = readFile(dir_ / "out" / "history.csv");
   EXPECT_EQ(std::count(history.begin(), history.end(), '\n'), 1 + 10 + 1) << "header, t = 0 and 10 steps of 1e-3 s";
+}
+
+// ---------------------------------------------------------------------------------------------
+// (e) Joint stops at the URDF limits, balanced inertias, and visual and collision meshes.
+
+// A 2 kg, 0.6 m rod hinged about y at its top end with limits [-0.5, 0.5] rad, swung into the
+// upper limit at 5 rad/s from 0.3 rad in gravity.
+const std::string kLimitedPendulum =
+    "<robot name=\"limited\">\n  <link name=\"world\"/>\n"
+    "  <link name=\"rod\"><inertial><origin xyz=\"0 0 -0.3\"/><mass value=\"2\"/>"
+    "<inertia ixx=\"0.0603\" iyy=\"0.0603\" izz=\"0.0005\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n"
+    "  <joint name=\"hinge\" type=\"revolute\"><parent link=\"world\"/><child link=\"rod\"/><axis xyz=\"0 1 0\"/>"
+    "<limit lower=\"-0.5\" upper=\"0.5\" effort=\"10\" velocity=\"10\"/></joint>\n</robot>\n";
+
+std::string limitedPendulumScene(const std::string& urdfAttributes) {
+  return "<metriplex name=\"limited\">\n  <simulation dt=\"0.001\" t_end=\"1\"/>\n  <gravity g=\"0 0 -9.81\"/>\n"
+         "  <urdf file=\"limited.urdf\"" +
+         urdfAttributes +
+         ">\n    <initial joint=\"hinge\" position=\"0.3\" velocity=\"5\"/>\n  </urdf>\n</metriplex>\n";
+}
+
+// The stop holds the rod near its limit (the free swing would reach about 1.6 rad), the damped
+// stop dissipates, and EEM keeps E + dissipated to round-off.
+TEST_F(UrdfTest, JointStopsHoldTheLimitAndBalanceTheEnergy) {
+  write("limited.urdf", kLimitedPendulum);
+  for (const char* damping : {"0", "5000"}) {
+    SCOPED_TRACE(std::string("limit_damping ") + damping);
+    const CompiledScene compiled = loadScene(
+        write("scene.xml", limitedPendulumScene(std::string(" limits=\"true\" limit_damping=\"") + damping + "\""))
+            .string());
+    const History h = run(*compiled.model, Scheme::Eem, 1e-3, 1.0, compiled.settings.newton);
+    ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+    double largest = -1.0;
+    for (const Eigen::VectorXd& z : h.states) {
+      const Vec3 centre = centreOf(*compiled.model, z, "rod");
+      largest = std::max(largest, std::atan2(-centre.x(), -centre.z()));
+    }
+    std::printf(
+        "stopped pendulum (limit_damping %s): largest angle %.4f rad (limit 0.5), dissipated %.4f J, "
+        "balance error %.2e\n",
+        damping, largest, h.dissipated.back(), h.summary.maxEnergyBalanceError);
+    EXPECT_GT(largest, 0.5);
+    EXPECT_LT(largest, 0.6);
+    EXPECT_LT(h.summary.maxEnergyBalanceError, 1e-10);
+    EXPECT_EQ(firstEntropyDecrease(h), -1);
+    if (std::string(damping) != "0") {
+      EXPECT_GT(h.dissipated.back(), 0.1);
+    }
+  }
+}
+
+// The warning about ignored limits goes with limits="true".
+TEST_F(UrdfTest, IgnoredLimitsWarnOnlyWithoutStops) {
+  write("limited.urdf", kLimitedPendulum);
+  const std::string run = " --t-end 0.01 --out " + quoted(dir_ / "out");
+  const Invocation without = metriplex("run " + quoted(write("scene.xml", limitedPendulumScene(""))) + run);
+  ASSERT_EQ(without.exitCode, kExitSuccess) << without.err;
+  EXPECT_NE(without.err.find("position limits of joints 'hinge' are ignored"), std::string::npos) << without.err;
+  const Invocation with =
+      metriplex("run " + quoted(write("scene.xml", limitedPendulumScene(" limits=\"true\""))) + run);
+  ASSERT_EQ(with.exitCode, kExitSuccess) << with.err;
+  EXPECT_EQ(with.err.find("warning"), std::string::npos) << with.err;
+}
+
+// A flat disk's moments 0.01 0.01 0.03 break J_3 < J_1 + J_2: balance_inertia raises the two
+// smaller ones to (1.01 J_3)/2 each and says so; without it the URDF is rejected.
+TEST_F(UrdfTest, BalanceInertiaRaisesTheSmallerMoments) {
+  write("disk.urdf", robotWith({kWorld, linkWith("arm", "1", "ixx=\"0.01\" iyy=\"0.01\" izz=\"0.03\""), kHinge}));
+  const std::string run = " --t-end 0.01 --out " + quoted(dir_ / "out");
+  const Invocation rejected = metriplex("run " +
+                                        quoted(write("scene.xml",
+                                                     "<metriplex>\n  <simulation dt=\"0.001\" t_end=\"1\"/>\n  <urdf "
+                                                     "file=\"disk.urdf\"/>\n</metriplex>\n")) +
+                                        run);
+  EXPECT_EQ(rejected.exitCode, kExitInvalidInput);
+  EXPECT_NE(rejected.err.find("triangle inequality"), std::string::npos) << rejected.err;
+  const Invocation balanced = metriplex("run " +
+                                        quoted(write("scene.xml",
+                                                     "<metriplex>\n  <simulation dt=\"0.001\" t_end=\"1\"/>\n  <urdf "
+                                                     "file=\"disk.urdf\" balance_inertia=\"true\"/>\n</metriplex>\n")) +
+                                        run);
+  ASSERT_EQ(balanced.exitCode, kExitSuccess) << balanced.err;
+  EXPECT_NE(balanced.err.find("link 'arm': principal moments 0.01 0.01 0.03"), std::string::npos) << balanced.err;
+  EXPECT_NE(balanced.err.find("raised them to 0.01515 0.01515 0.03"), std::string::npos) << balanced.err;
+}
+
+// Visual and collision geometry, meshes with package:// references included, is not physics:
+// the import ignores it without a word.
+TEST_F(UrdfTest, MeshesAndPackageReferencesAreIgnoredQuietly) {
+  const std::string geometry = "<geometry><mesh filename=\"package://foo/meshes/bar.stl\" scale=\"1 1 1\"/></geometry>";
+  const std::string arm = "<link name=\"arm\"><inertial><mass value=\"1\"/><inertia " + kBox +
+                          " ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><visual><origin xyz=\"0 0 0.1\"/>" + geometry +
+                          "<material name=\"blue\"><color rgba=\"0 0 1 1\"/></material></visual><collision>" +
+                          geometry +
+                          "</collision><collision><geometry><box size=\"0.1 0.1 0.2\"/></geometry>"
+                          "</collision></link>";
+  const fs::path urdf = write("meshes.urdf", robotWith({kWorld, arm, kHinge}));
+  const Invocation r = metriplex("run " + quoted(urdf) + " --t-end 0.01 --out " + quoted(dir_ / "out"));
+  ASSERT_EQ(r.exitCode, kExitSuccess) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(readFile(dir_ / "out" / "history.csv"), [&] {
+    const fs::path plain = write("plain.urdf", kValidRobot);
+    metriplex("run " + quoted(plain) + " --t-end 0.01 --out " + quoted(dir_ / "plain"));
+    return readFile(dir_ / "plain" / "history.csv");
+  }()) << "the geometry changes nothing";
 }
 
 }  // namespace

@@ -3,87 +3,123 @@
 namespace mpx {
 
 namespace {
-// Append a mass point's position and velocity dofs.
-void appendMassDofs(const Endpoint& end, std::vector<int>& dofs) {
-  if (!end.isMass()) return;
-  for (int k = 0; k < 3; ++k) dofs.push_back(end.positionDof + k);
-  for (int k = 0; k < 3; ++k) dofs.push_back(end.velocityDof + k);
-}
-
-Vec3 pointIn(const Endpoint& end, const double* z) {
-  return end.isMass() ? Vec3(z[end.positionDof], z[end.positionDof + 1], z[end.positionDof + 2]) : end.anchor;
-}
-
-Vec3 rateIn(const Endpoint& end, const double* zdot) {
-  return end.isMass() ? Vec3(zdot[end.positionDof], zdot[end.positionDof + 1], zdot[end.positionDof + 2])
-                      : Vec3::Zero();
+// sum_k weights[k] y_k with y_k the k-th 3-vector from `first` in v.
+Vec3 combination(const Endpoint& end, const double* v, int first) {
+  Vec3 x = Vec3::Zero();
+  for (int k = 0; k < end.terms; ++k)
+    x += end.weights[k] * Vec3(v[first + 3 * k], v[first + 3 * k + 1], v[first + 3 * k + 2]);
+  return x;
 }
 }  // namespace
 
-TwoPointGeometry::TwoPointGeometry(const Endpoint& a, const Endpoint& b) : a_(a), b_(b) {
+Endpoint Endpoint::fixed(const Vec3& position) {
+  Endpoint end;
+  end.anchor = position;
+  return end;
+}
+
+Endpoint Endpoint::point(int positionDof, int velocityDof) {
+  Endpoint end;
+  end.positionDof = positionDof;
+  end.velocityDof = velocityDof;
+  end.terms = 1;
+  end.weights[0] = 1.0;
+  return end;
+}
+
+Endpoint Endpoint::bodyPoint(int positionDof, int velocityDof, const Vec3& bodyCoordinates) {
+  Endpoint end = point(positionDof, velocityDof);
+  end.terms = 4;
+  for (int i = 0; i < 3; ++i) end.weights[1 + i] = bodyCoordinates[i];
+  return end;
+}
+
+Vec3 Endpoint::in(const double* z) const { return moves() ? combination(*this, z, positionDof) : anchor; }
+
+TwoPointGeometry::TwoPointGeometry(const Endpoint& a, const Endpoint& b) {
+  ends_[0].point = b;
+  ends_[1].point = a;
+  ends_[1].sign = -1.0;
+  // a's dofs come first locally
   int next = 0;
-  if (a_.isMass()) {
-    localPositionA_ = next;
-    localVelocityA_ = next + 3;
-    next += 6;
-  }
-  if (b_.isMass()) {
-    localPositionB_ = next;
-    localVelocityB_ = next + 3;
+  for (int e : {1, 0}) {
+    End& end = ends_[e];
+    if (!end.point.moves()) continue;
+    end.localPosition = next;
+    end.localVelocity = next + 3 * end.point.terms;
+    next += 6 * end.point.terms;
   }
 }
 
 std::vector<int> TwoPointGeometry::dofs() const {
   std::vector<int> dofs;
-  appendMassDofs(a_, dofs);
-  appendMassDofs(b_, dofs);
+  for (int e : {1, 0}) {
+    const Endpoint& end = ends_[e].point;
+    for (int i = 0; i < 3 * end.terms; ++i) dofs.push_back(end.positionDof + i);
+    for (int i = 0; i < 3 * end.terms; ++i) dofs.push_back(end.velocityDof + i);
+  }
   return dofs;
 }
 
-Vec3 TwoPointGeometry::separation(const double* z) const { return pointIn(b_, z) - pointIn(a_, z); }
+Vec3 TwoPointGeometry::separation(const double* z) const { return ends_[0].point.in(z)-ends_[1].point.in(z); }
 
-Vec3 TwoPointGeometry::separationRate(const double* zdot) const { return rateIn(b_, zdot) - rateIn(a_, zdot); }
-
-Vec3 TwoPointGeometry::separationVelocity(const double* z) const {
-  auto velocity = [z](const Endpoint& end) {
-    return end.isMass() ? Vec3(z[end.velocityDof], z[end.velocityDof + 1], z[end.velocityDof + 2]) : Vec3::Zero();
-  };
-  return velocity(b_) - velocity(a_);
+Vec3 TwoPointGeometry::separationRate(const double* zdot) const {
+  return combination(ends_[0].point, zdot, ends_[0].point.positionDof) -
+         combination(ends_[1].point, zdot, ends_[1].point.positionDof);
 }
 
+Vec3 TwoPointGeometry::separationVelocity(const double* z) const {
+  return combination(ends_[0].point, z, ends_[0].point.velocityDof) -
+         combination(ends_[1].point, z, ends_[1].point.velocityDof);
+}
+
+// The force on an end point enters its momentum rows through the transpose of its map:
+// weights[k] * force on the rows of y_k.
 void TwoPointGeometry::addForce(LocalSystem& local, const Vec3& force) const {
   auto r = local.residual();
-  if (localVelocityB_ >= 0) r.segment<3>(localVelocityB_) += force;
-  if (localVelocityA_ >= 0) r.segment<3>(localVelocityA_) -= force;
+  for (const End& end : ends_)
+    for (int k = 0; k < end.point.terms; ++k)
+      r.segment<3>(end.localVelocity + 3 * k) += (end.sign * end.point.weights[k]) * force;
 }
 
 void TwoPointGeometry::addForceTangent(LocalSystem& local, const Vec3& direction, const LocalRow& dForce) const {
   auto K = local.tangent();
-  if (localVelocityB_ >= 0) K.middleRows(localVelocityB_, 3) += direction * dForce;
-  if (localVelocityA_ >= 0) K.middleRows(localVelocityA_, 3) -= direction * dForce;
+  for (const End& end : ends_)
+    for (int k = 0; k < end.point.terms; ++k)
+      K.middleRows(end.localVelocity + 3 * k, 3) += (end.sign * end.point.weights[k]) * direction * dForce;
 }
 
 void TwoPointGeometry::addSeparationTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDd) const {
-  addMomentumTangent(local, dForceDd, localPositionB_, localPositionA_);
+  addMomentumTangent(local, dForceDd, false);
 }
 
 void TwoPointGeometry::addSeparationVelocityTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDw) const {
-  addMomentumTangent(local, dForceDw, localVelocityB_, localVelocityA_);
+  addMomentumTangent(local, dForceDw, true);
 }
 
-void TwoPointGeometry::addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, int columnB,
-                                          int columnA) const {
+void TwoPointGeometry::addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce,
+                                          bool velocityColumns) const {
   auto K = local.tangent();
-  const int rows[2] = {localVelocityB_, localVelocityA_};
-  const int cols[2] = {columnB, columnA};
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      if (rows[i] >= 0 && cols[j] >= 0) K.block<3, 3>(rows[i], cols[j]) += (i == j ? 1.0 : -1.0) * dForce;
+  for (const End& row : ends_)
+    for (const End& column : ends_) {
+      const int firstColumn = velocityColumns ? column.localVelocity : column.localPosition;
+      for (int k = 0; k < row.point.terms; ++k)
+        for (int l = 0; l < column.point.terms; ++l)
+          K.block<3, 3>(row.localVelocity + 3 * k, firstColumn + 3 * l) +=
+              (row.sign * column.sign * row.point.weights[k] * column.point.weights[l]) * dForce;
+    }
 }
 
 void TwoPointGeometry::addSeparationRow(LocalRow& row, const Vec3& w) const {
-  if (localPositionB_ >= 0) row.segment<3>(localPositionB_) += w.transpose();
-  if (localPositionA_ >= 0) row.segment<3>(localPositionA_) -= w.transpose();
+  for (const End& end : ends_)
+    for (int k = 0; k < end.point.terms; ++k)
+      row.segment<3>(end.localPosition + 3 * k) += (end.sign * end.point.weights[k]) * w.transpose();
+}
+
+bool TwoPointGeometry::isPosition(int local) const {
+  for (const End& end : ends_)
+    if (end.point.moves() && local >= end.localPosition && local < end.localPosition + 3 * end.point.terms) return true;
+  return false;
 }
 
 }  // namespace mpx

@@ -1,25 +1,43 @@
 #pragma once
-// The separation d = x_b - x_a between two end points, each a mass point (state dofs) or a
-// fixed anchor, and how forces along it enter the momentum rows of the local system.
+// The separation d = x_b - x_a between two end points, and how forces along it enter the
+// momentum rows of the local system. Each end point is a fixed point in space or a fixed
+// linear combination of position dofs (a mass point; a body point phi + X_i d_i), so d is
+// linear in the state: discrete gradients through d stay exact, and a force along d acting on
+// each end through the transpose of that combination keeps linear and angular momentum.
 #include "engine/core/component.hpp"
 
+#include <array>
 #include <vector>
 
 namespace mpx {
 
-// A mass point's global dofs (x component; y, z follow) or a fixed point in space.
+// x = sum_k weights[k] y_k over `terms` consecutive 3-vectors y_k of position dofs from
+// positionDof (a mass: its position; a body point: the centre of mass and the three directors
+// with the point's body coordinates), its velocity the same combination from velocityDof;
+// with no terms, the fixed point `anchor`.
 struct Endpoint {
+  static constexpr int kMaxTerms = 4;
   int positionDof = -1;
   int velocityDof = -1;
+  int terms = 0;
+  std::array<double, kMaxTerms> weights{};
   Vec3 anchor = Vec3::Zero();
-  bool isMass() const { return positionDof >= 0; }
+
+  static Endpoint fixed(const Vec3& position);
+  static Endpoint point(int positionDof, int velocityDof);
+  // phi + X_i d_i of a body whose phi, d1, d2, d3 start at positionDof.
+  static Endpoint bodyPoint(int positionDof, int velocityDof, const Vec3& bodyCoordinates);
+  bool moves() const { return terms > 0; }
+  // The point in state z (the anchor for a fixed point).
+  Vec3 in(const double* z) const;
 };
 
 class TwoPointGeometry {
  public:
-  // The local dofs start with those of the mass end points (position then velocity, 3 each).
+  // The local dofs are those of the moving end points, each end's position terms then its
+  // velocity terms (3 each).
   TwoPointGeometry(const Endpoint& a, const Endpoint& b);
-  // Global indices of those leading local dofs.
+  // Global indices of those local dofs.
   std::vector<int> dofs() const;
 
   // x_b - x_a in state z.
@@ -40,17 +58,19 @@ class TwoPointGeometry {
   // Row over local dofs of d(w . d)/dz.
   void addSeparationRow(LocalRow& row, const Vec3& w) const;
   // Whether local dof `local` is an end point's position (a row these elements never write).
-  bool isPosition(int local) const {
-    return (local >= localPositionA_ && local < localPositionA_ + 3 && localPositionA_ >= 0) ||
-           (local >= localPositionB_ && local < localPositionB_ + 3 && localPositionB_ >= 0);
-  }
+  bool isPosition(int local) const;
 
  private:
-  // Add dForce/dy (3x3) to the momentum rows for columns y of b (+) and a (-).
-  void addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, int columnB, int columnA) const;
+  // An end point with the sign of its force (b +, a -) and where its dofs sit locally.
+  struct End {
+    Endpoint point;
+    double sign = 1.0;
+    int localPosition = -1, localVelocity = -1;
+  };
+  // Add dForce/dy (3x3) to the momentum rows, y the position (or velocity) terms of the ends.
+  void addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, bool velocityColumns) const;
 
-  Endpoint a_, b_;
-  int localPositionA_ = -1, localVelocityA_ = -1, localPositionB_ = -1, localVelocityB_ = -1;
+  std::array<End, 2> ends_;  // b, a
 };
 
 }  // namespace mpx

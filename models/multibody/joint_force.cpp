@@ -68,7 +68,7 @@ JointForce::ArgumentJacobian JointForce::invariantJacobian(const ConstraintVecto
 
 unsigned JointForce::mask() const { return (spec_.revolute ? 3u : 1u) | (localInternal_ >= 0 ? 4u : 0u); }
 
-Jet JointForce::energy(const Vec3& args) const {
+Jet JointForce::springEnergy(const Vec3& args) const {
   const double k = spec_.stiffness, kb = spec_.branchStiffness;
   if (spec_.revolute) {
     // spring k (1 - cos(theta - theta0)) and branch kb (1 - cos(theta - gamma))
@@ -97,6 +97,50 @@ Jet JointForce::energy(const Vec3& args) const {
   jet.hess(0, 0) += kb;
   jet.hess(kInternal, kInternal) = kb;
   jet.hess(0, kInternal) = jet.hess(kInternal, 0) = -kb;
+  return jet;
+}
+
+namespace {
+// The coordinate minus the middle of the stops' range, for a revolute angle in a chart
+// centred on that middle (smooth up to half a turn away).
+Jet fromRangeMiddle(bool revolute, const Vec3& args, const JointStop& stop) {
+  const double middle = 0.5 * (stop.lower + stop.upper);
+  if (!revolute) {
+    Jet jet = jointCoordinateChart(false, args, args);
+    jet.value -= middle;
+    return jet;
+  }
+  return jointCoordinateChart(true, args, Vec3(std::cos(middle), std::sin(middle), 0.0));
+}
+}  // namespace
+
+JointForce::Penetration JointForce::penetration(const Vec3& args) const {
+  const Jet offset = fromRangeMiddle(spec_.revolute, args, *spec_.stop);
+  const double depth = std::abs(offset.value) - 0.5 * (spec_.stop->upper - spec_.stop->lower);
+  if (!(depth > 0.0)) return {};
+  return {depth, (offset.value > 0.0 ? 1.0 : -1.0) * offset.grad};
+}
+
+Jet JointForce::stopEnergy(const Vec3& args) const {
+  Jet jet;
+  const Penetration p = penetration(args);
+  if (!(p.depth > 0.0)) return jet;
+  // V(delta) = k/3 delta^3 with delta'' the signed Hessian of the chart
+  const Jet offset = fromRangeMiddle(spec_.revolute, args, *spec_.stop);
+  const double k = spec_.stop->stiffness, sign = offset.value > 0.0 ? 1.0 : -1.0;
+  jet.value = k / 3.0 * p.depth * p.depth * p.depth;
+  jet.grad = k * p.depth * p.depth * p.grad;
+  jet.hess = 2.0 * k * p.depth * p.grad * p.grad.transpose() + sign * k * p.depth * p.depth * offset.hess;
+  return jet;
+}
+
+Jet JointForce::energy(const Vec3& args) const {
+  Jet jet = springEnergy(args);
+  if (!spec_.stop) return jet;
+  const Jet stop = stopEnergy(args);
+  jet.value += stop.value;
+  jet.grad += stop.grad;
+  jet.hess += stop.hess;
   return jet;
 }
 
@@ -138,21 +182,29 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
       [&](const Vec3& a) { return jointCoordinateChart(spec_.revolute, a, a0); }, coordinateMask, a0, a1, scale);
   const Jet coordinateEnd = jointCoordinateChart(spec_.revolute, a1, a0);
   const double rate = (coordinateEnd.value - jointCoordinateChart(spec_.revolute, a0, a0).value) / args.dt;
+  const ConstraintRow dRate = (coordinateEnd.grad.transpose() * J1) / args.dt;
   double dForce = 0.0;
-  const double force = dissipativeForce(rate, &dForce);
+  double force = dissipativeForce(rate, &dForce);
+  ConstraintRow dForceDq = dForce * dRate;
+  if (spec_.stop) {
+    // stop damping c_s (delta^2 + delta'^2)/2 times the rate: non-negative work like the damper's
+    const Penetration p0 = penetration(a0), p1 = penetration(a1);
+    const double c = spec_.stop->damping, coefficient = 0.5 * c * (p0.depth * p0.depth + p1.depth * p1.depth);
+    force += coefficient * rate;
+    dForceDq += coefficient * dRate + (c * rate * p1.depth) * (p1.grad.transpose() * J1);
+  }
   const Vec3 forceOnArguments = dEnergy.grad + force * dCoordinate.grad;
   // the rows of J for unused slots (and gamma) are zero: only invariants push on q
   r.segment(n_, n_) += JMid.transpose() * forceOnArguments;
 
   // tangent w.r.t. q1 through I1 in the discrete gradients, the rate, and grad I(q_mid)
-  const ConstraintRow dRate = (coordinateEnd.grad.transpose() * J1) / args.dt;
   K.block(n_, 0, n_, n_) += JMid.transpose() * (dEnergy.dGradDb + force * dCoordinate.dGradDb) * J1 +
-                            JMid.transpose() * dCoordinate.grad * (dForce * dRate);
+                            JMid.transpose() * dCoordinate.grad * dForceDq;
   for (int a = 0; a < m; ++a) K.block(n_, 0, n_, n_) += 0.5 * forceOnArguments[a] * spec_.invariants[a].hessian;
 
   // Maxwell branch: nu (gamma' - gamma)/dt = -D_gamma e, dissipating (D_gamma e)^2 / nu
   double power = force * rate;
-  ConstraintRow dPowerDq = (dForce * rate + force) * dRate;
+  ConstraintRow dPowerDq = rate * dForceDq + force * dRate;
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     const double nu = spec_.viscosity, g = -dEnergy.grad[kInternal];
@@ -181,26 +233,34 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
   const Jet e = energy(a), angle = jointCoordinateChart(spec_.revolute, a, a);
   const Vec3 invariantRate = J * qRate;
   const double rate = angle.grad.dot(invariantRate);
+  // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dv
+  ConstraintRow dRateDq = (angle.hess * invariantRate).transpose() * J;
+  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * qRate).transpose();
+  const ConstraintRow dRateDv = angle.grad.transpose() * J;
   double dForce = 0.0;
-  const double force = dissipativeForce(rate, &dForce);
+  double force = dissipativeForce(rate, &dForce);
+  ConstraintRow dForceDq = dForce * dRateDq, dForceDv = dForce * dRateDv;
+  if (spec_.stop) {
+    // stop damping c_s delta^2 times the rate
+    const Penetration p = penetration(a);
+    const double c = spec_.stop->damping, coefficient = c * p.depth * p.depth;
+    force += coefficient * rate;
+    dForceDq += coefficient * dRateDq + (2.0 * c * rate * p.depth) * (p.grad.transpose() * J);
+    dForceDv += coefficient * dRateDv;
+  }
   const Vec3 forceOnArguments = e.grad + force * angle.grad;
   auto r = out.residual();
   auto K = out.tangent();
   r.segment(n_, n_) += J.transpose() * forceOnArguments;
 
-  // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dv
-  ConstraintRow dRateDq = (angle.hess * invariantRate).transpose() * J;
-  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * qRate).transpose();
-  const ConstraintRow dRateDv = angle.grad.transpose() * J;
   const ConstraintVector direction = J.transpose() * angle.grad;
-  K.block(n_, 0, n_, n_) +=
-      args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * (dForce * dRateDq));
-  K.block(n_, n_, n_, n_) += args.alpha * direction * (dForce * dRateDv);
+  K.block(n_, 0, n_, n_) += args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * dForceDq);
+  K.block(n_, n_, n_, n_) += args.alpha * direction * dForceDv;
   for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * forceOnArguments[i] * spec_.invariants[i].hessian;
 
   double power = force * rate;
-  ConstraintRow dPowerDq = (dForce * rate + force) * args.alpha * dRateDq;
-  const ConstraintRow dPowerDv = (dForce * rate + force) * args.alpha * dRateDv;
+  ConstraintRow dPowerDq = args.alpha * (rate * dForceDq + force * dRateDq);
+  const ConstraintRow dPowerDv = args.alpha * (rate * dForceDv + force * dRateDv);
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     // nu gamma' = -de/dgamma, dissipating (de/dgamma)^2 / nu

@@ -9,12 +9,26 @@
 //              (D_gamma e)^2 / nu;
 //   dissipation f = c dtheta/dt + F tanh(dtheta/(dt v_s)), force f D_I theta . grad I(q_mid),
 //              dissipated energy f dtheta >= 0 per step exactly,
-// with theta(I) taken in a chart centred on the step's start (no wrap-around). The dissipated
+// with theta(I) taken in a chart centred on the step's start (no wrap-around). Optional stops
+// at lower <= theta <= upper add the potential k_s/3 delta^3 of the depth delta beyond the
+// nearer limit (C2: zero with its first two derivatives at contact) and the damping force
+// c_s delta^2 dtheta/dt (in EEM with delta^2 averaged over the step's ends), which dissipates
+// like the damper; a revolute stop's angle is taken in a chart centred on the middle of the
+// range, so the range must be below a full turn. The dissipated
 // power leaves as `dissipated`, or heats a thermal node (a reservoir) when one is given, so an
 // isolated system keeps E exactly and produces entropy.
 #include "models/multibody/joint_coordinate.hpp"
 
+#include <optional>
+
 namespace mpx {
+
+// Limits of a joint coordinate (relative to its t = 0 value, as rest), a stop's stiffness
+// k_s and damping c_s.
+struct JointStop {
+  double lower = 0.0, upper = 0.0;
+  double stiffness = 0.0, damping = 0.0;
+};
 
 struct JointForceSpec {
   std::string name;
@@ -29,6 +43,7 @@ struct JointForceSpec {
   double damping = 0.0;                           // viscous coefficient
   double friction = 0.0, frictionVelocity = 1.0;  // smoothed Coulomb
   int heatDof = -1;                               // thermal dof heated by the dissipation, -1: none
+  std::optional<JointStop> stop;                  // stops at the coordinate's limits, none: free
 };
 
 class JointForce final : public Component {
@@ -46,10 +61,19 @@ class JointForce final : public Component {
   ConstraintVector gather(const double* z, int shift) const;
   // (I_0, I_1, gamma) of a state; unused slots are 0.
   Vec3 arguments(const double* z) const;
-  // Stored energy e(I, gamma) with gradient and Hessian.
+  // Stored energy e(I, gamma) with gradient and Hessian: springs and stops.
   Jet energy(const Vec3& args) const;
+  Jet springEnergy(const Vec3& args) const;
   // Generalised dissipative force for a coordinate rate, and its derivative.
   double dissipativeForce(double rate, double* dForce) const;
+  // Depth beyond the nearer stop, and its gradient over the arguments (zero inside the range).
+  struct Penetration {
+    double depth = 0.0;
+    Vec3 grad = Vec3::Zero();
+  };
+  Penetration penetration(const Vec3& args) const;
+  // The stop potential k_s/3 delta^3 over the arguments.
+  Jet stopEnergy(const Vec3& args) const;
   // d(I_0, I_1, gamma)/dq at q: one row per argument slot, zero for gamma and unused slots.
   using ArgumentJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxConstrainedDofs>;
   ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;

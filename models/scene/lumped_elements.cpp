@@ -1,4 +1,5 @@
 // Point masses, anchors, two-point force elements and point loads (docs/scene-format.md).
+#include "models/lumped/actuator.hpp"
 #include "models/lumped/damper.hpp"
 #include "models/lumped/element_laws.hpp"
 #include "models/lumped/external_force.hpp"
@@ -14,7 +15,7 @@ void buildMass(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   const std::string name = build.declareName(in);
   const double mass = in.positive("mass");
   const int position = dofs.take(Block::Position, 3);
-  const Endpoint end{position, position + build.velocityShift(), Vec3::Zero()};
+  const Endpoint end = Endpoint::point(position, position + build.velocityShift());
   build.state.segment<3>(end.positionDof) = in.vector("position", Vec3::Zero());
   build.state.segment<3>(end.velocityDof) = in.vector("velocity", Vec3::Zero());
   build.keepPositionScale(build.state.segment<3>(end.positionDof).norm());
@@ -27,8 +28,7 @@ void buildMass(ElementReader& in, SceneBuild& build, DofRange& dofs) {
 
 void buildAnchor(ElementReader& in, SceneBuild& build, DofRange&) {
   const std::string name = build.declareName(in);
-  Endpoint end;
-  end.anchor = in.vector("position", Vec3::Zero());
+  const Endpoint end = Endpoint::fixed(in.vector("position", Vec3::Zero()));
   build.keepPositionScale(end.anchor.norm());
   build.points[name] = end;
   build.attachments[name] = Attachment{Attachment::Kind::Ground, -1, end.anchor, Mat3::Identity()};
@@ -63,10 +63,17 @@ void buildDamper(ElementReader& in, SceneBuild& build, DofRange&) {
   build.addComponent(std::make_unique<Damper>(name, a, b, in.positive("coefficient")));
 }
 
+void buildActuator(ElementReader& in, SceneBuild& build, DofRange&) {
+  const std::string name = build.declareName(in);
+  const auto [a, b] = build.endpoints(in);
+  const double force = in.number("force");
+  build.addComponent(std::make_unique<Actuator>(name, a, b, force, readProfile(in, build)));
+}
+
 void buildForce(ElementReader& in, SceneBuild& build, DofRange&) {
   const std::string name = build.declareName(in);
   const Endpoint on = build.endpoint(in, "on");
-  if (!on.isMass()) in.fail("attribute 'on' must name a mass or a body (its centre of mass), not an anchor");
+  if (!on.moves()) in.fail("attribute 'on' must name a mass or a body (its centre of mass), not an anchor");
   const Vec3 force = in.vector("force", Vec3::Zero());
   build.addComponent(
       std::make_unique<ExternalForce>(name, on.positionDof, on.velocityDof, force, readProfile(in, build)));
@@ -89,6 +96,7 @@ const std::vector<ElementKind>& lumpedElementKinds() {
        },
        [](ElementReader& in, SceneBuild& b, DofRange& d) { buildHookeElement(in, b, d, true); }},
       {"damper", nullptr, buildDamper},
+      {"actuator", nullptr, buildActuator},
       {"force", nullptr, buildForce},
   };
   return kinds;

@@ -8,6 +8,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <cmath>
+
 namespace mpx {
 
 namespace {
@@ -59,7 +61,7 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     build.state.segment<3>(phiRate + 3 + 3 * i) = angularVelocity.cross(directors.col(i));
   }
   build.keepPositionScale(position.norm());
-  build.points[name] = Endpoint{phi, phiRate, Vec3::Zero()};
+  build.points[name] = Endpoint::point(phi, phiRate);
   build.attachments[name] = Attachment{Attachment::Kind::Body, phi, position, directors};
   build.bodyFrames.push_back({name, phi, directors.transpose() * rotation});
   build.addComponent(std::make_unique<Inertia>(
@@ -122,6 +124,21 @@ DofDemand declareJointForce(ElementReader& in, SceneBuild& build) {
   return {0, 0, spherical ? 3 : 1, 0};
 }
 
+// lower, upper (the joint's convention, as rest), limit_stiffness and limit_damping of a joint force.
+JointStop readJointStop(ElementReader& in, const DeclaredJoint& joint) {
+  if (joint.type == JointType::Spherical) in.fail("lower and upper apply to revolute and prismatic joints");
+  JointStop stop;
+  stop.lower = in.number("lower") - joint.coordinate;
+  stop.upper = in.number("upper") - joint.coordinate;
+  if (!(stop.lower < stop.upper)) in.fail("lower must be below upper");
+  // a revolute stop's chart is centred on the middle of the range
+  if (joint.type == JointType::Revolute && !(stop.upper - stop.lower < 2.0 * M_PI))
+    in.fail("the range of a revolute joint's stops must be below a full turn (2 pi)");
+  stop.stiffness = in.positive("limit_stiffness");
+  stop.damping = in.nonNegative("limit_damping", 0.0);
+  return stop;
+}
+
 void buildJointForce(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   JointForceSpec spec;
   spec.name = build.declareName(in);
@@ -150,6 +167,7 @@ void buildJointForce(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     spec.branchStiffness = in.positive("branch_stiffness");
     spec.viscosity = in.positive("viscosity");
   }
+  if (in.has("lower") || in.has("upper")) spec.stop = readJointStop(in, joint->second);
   spec.damping = in.nonNegative("damping", 0.0);
   spec.friction = in.nonNegative("friction", 0.0);
   spec.frictionVelocity = in.positive("friction_velocity", 1e-2);

@@ -86,12 +86,24 @@ Endpoint SceneBuild::endpoint(ElementReader& in, const char* attribute) const {
   return declared(points, in, attribute, "mass or anchor", "declared above this element");
 }
 
-Vec3 SceneBuild::positionOf(const Endpoint& end) const {
-  return end.isMass() ? Vec3(state.segment<3>(end.positionDof)) : end.anchor;
+Vec3 SceneBuild::positionOf(const Endpoint& end) const { return end.in(state.data()); }
+
+Endpoint SceneBuild::endpointAt(ElementReader& in, const char* attribute, const char* pointAttribute) const {
+  if (!in.has(pointAttribute)) return endpoint(in, attribute);
+  const Attachment& body = attachment(in, attribute);
+  if (body.kind != Attachment::Kind::Body)
+    in.fail(std::string("attribute '") + pointAttribute + "': '" + in.text(attribute) +
+            "' is not a body (only a body has points besides its position)");
+  // body coordinates X = D0^T (p - phi0), as a joint's anchor
+  const Vec3 X = body.directors.transpose() * (in.vector(pointAttribute, body.position) - body.position);
+  return Endpoint::bodyPoint(body.firstPositionDof, body.firstPositionDof + velocityShift(), X);
 }
 
 std::pair<Endpoint, Endpoint> SceneBuild::endpoints(ElementReader& in) {
-  const Endpoint a = endpoint(in, "a"), b = endpoint(in, "b");
+  const Endpoint a = endpointAt(in, "a", "a_point"), b = endpointAt(in, "b", "b_point");
+  // two points of one body keep their distance (and would share dofs)
+  if (a.moves() && a.positionDof == b.positionDof && (a.terms > 1 || b.terms > 1))
+    in.fail("end points 'a' and 'b' are on the same body: their distance cannot change");
   const double length = (positionOf(b) - positionOf(a)).norm();
   if (!(length > 0.0)) in.fail("end points 'a' and 'b' coincide: the element has no direction");
   keepPositionScale(length);

@@ -117,7 +117,10 @@ class SceneBuild {
   std::string declareName(ElementReader& in);
   // The mass or anchor named by `attribute`.
   Endpoint endpoint(ElementReader& in, const char* attribute) const;
-  // Attributes 'a' and 'b' of a two-point element, apart.
+  // The end point `attribute` of a two-point element, at the body point `pointAttribute`
+  // (world coordinates at t = 0, moving with the body) when that is given.
+  Endpoint endpointAt(ElementReader& in, const char* attribute, const char* pointAttribute) const;
+  // Ends 'a' and 'b' of a two-point element (at 'a_point', 'b_point'), apart, not on one body.
   std::pair<Endpoint, Endpoint> endpoints(ElementReader& in);
   // The body, mass or anchor named by `attribute`.
   const Attachment& attachment(ElementReader& in, const char* attribute) const;

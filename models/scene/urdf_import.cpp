@@ -206,9 +206,11 @@ class UrdfTranslator {
   Vec3 unitAxis(const urdf::Joint& joint) const;
   static bool massless(const urdf::Link& link);
   void addBody(const urdf::Link& link, const LinkState& state);
-  void checkInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const;
+  // The link's inertia tensor, checked; balanced when the options allow it.
+  Eigen::Matrix3d checkedInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const;
   void addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child);
   void addDynamics(const urdf::Joint& joint);
+  void addStops(const urdf::Joint& joint);
   void reportIgnored() const;
   std::string sceneName(const std::string& urdfName) const { return options_.prefix + urdfName; }
   // A new scene element named `urdfName` (prefixed), made from the URDF's <kind name="source">.
@@ -218,7 +220,7 @@ class UrdfTranslator {
   const urdf::ModelInterface& robot_;
   const UrdfImportOptions& options_;
   SceneSpec& scene_;
-  std::vector<std::string> limitedJoints_, ignoredDynamics_;
+  std::vector<std::string> limitedJoints_, fullTurnLimits_, ignoredDynamics_;
 };
 
 void UrdfTranslator::translate() {
@@ -357,7 +359,7 @@ void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
     file_.fail("link", link.name, "mass must be positive and finite, got " + number(i.mass));
   Eigen::Matrix3d tensor;
   tensor << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-  checkInertia(link, tensor);
+  tensor = checkedInertia(link, tensor);
   // the tensor is given about the centre of mass in the inertial frame: the body's orientation
   const Pose inertialFrame = state.frame * toEigen(i.origin);
   const Vec3 centre = inertialFrame.translation();
@@ -365,7 +367,8 @@ void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
   const Vec3 velocity = state.originVelocity + state.angularVelocity.cross(centre - state.frame.translation());
   emit("body", link.name, "link", link.name)
       .set("mass", i.mass)
-      .set("inertia", std::vector<double>{i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz})
+      .set("inertia",
+           std::vector<double>{tensor(0, 0), tensor(1, 1), tensor(2, 2), tensor(0, 1), tensor(0, 2), tensor(1, 2)})
       .set("position", centre)
       .set("orientation", q)
       .set("velocity", velocity)
@@ -373,17 +376,29 @@ void UrdfTranslator::addBody(const urdf::Link& link, const LinkState& state) {
 }
 
 // A director body's "masses" (J_j + J_k - J_i)/2 must be positive: principal moments need the
-// strict triangle inequality (no regularisation: a degenerate tensor is rejected).
-void UrdfTranslator::checkInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const {
+// strict triangle inequality. A tensor that violates it is rejected, or with balance_inertia
+// its two smaller moments are raised by the same amount until J_1 + J_2 = (1 + margin) J_3, in
+// the same principal axes.
+Eigen::Matrix3d UrdfTranslator::checkedInertia(const urdf::Link& link, const Eigen::Matrix3d& tensor) const {
+  constexpr double kBalanceMargin = 1e-2;
   if (!tensor.allFinite()) file_.fail("link", link.name, "the inertia must be finite");
-  const Vec3 J = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor, Eigen::EigenvaluesOnly).eigenvalues();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(tensor);
+  const Vec3 J = principal.eigenvalues();
   if (!(J[0] > 0.0))
     file_.fail("link", link.name,
                "the inertia tensor must be positive definite; its principal moments are " + numbers(J));
-  if (!(J[0] + J[1] > J[2]))
+  if (J[0] + J[1] > J[2]) return tensor;
+  if (!options_.balanceInertia)
     file_.fail("link", link.name,
                "the principal moments " + numbers(J) +
-                   " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need");
+                   " violate the strict triangle inequality J_i < J_j + J_k that rigid bodies need "
+                   "(<urdf balance_inertia=\"true\"> raises them)");
+  const double raise = 0.5 * ((1.0 + kBalanceMargin) * J[2] - J[0] - J[1]);
+  const Vec3 balanced(J[0] + raise, J[1] + raise, J[2]);
+  warn(file_.path(), "link '" + link.name + "': principal moments " + numbers(J) +
+                         " violate the triangle inequality J_i < J_j + J_k; balance_inertia raised them to " +
+                         numbers(balanced));
+  return principal.eigenvectors() * balanced.asDiagonal() * principal.eigenvectors().transpose();
 }
 
 void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent, const LinkState& child) {
@@ -399,8 +414,12 @@ void UrdfTranslator::addJoint(const urdf::Joint& joint, const LinkState& parent,
 
 void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
   if ((joint.type == urdf::Joint::REVOLUTE || joint.type == urdf::Joint::PRISMATIC) && joint.limits &&
-      joint.limits->lower < joint.limits->upper)
-    limitedJoints_.push_back(joint.name);
+      joint.limits->lower < joint.limits->upper) {
+    if (options_.limits)
+      addStops(joint);
+    else
+      limitedJoints_.push_back(joint.name);
+  }
   if (!joint.dynamics || (joint.dynamics->damping == 0.0 && joint.dynamics->friction == 0.0)) return;
   if (!(joint.dynamics->damping >= 0.0 && joint.dynamics->friction >= 0.0) || !std::isfinite(joint.dynamics->damping) ||
       !std::isfinite(joint.dynamics->friction))
@@ -416,9 +435,30 @@ void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
       .set("friction_velocity", kFrictionVelocity);
 }
 
+// Stops at the joint's position limits, in the URDF's coordinate (the scene joint's `coordinate`).
+void UrdfTranslator::addStops(const urdf::Joint& joint) {
+  const double lower = joint.limits->lower, upper = joint.limits->upper;
+  if (!std::isfinite(lower) || !std::isfinite(upper)) file_.fail("joint", joint.name, "the limits must be finite");
+  // a revolute stop's chart spans less than a full turn
+  if (joint.type == urdf::Joint::REVOLUTE && !(upper - lower < 2.0 * M_PI)) {
+    fullTurnLimits_.push_back(joint.name);
+    return;
+  }
+  emit("joint_force", joint.name + ".limits", "joint", joint.name)
+      .set("joint", sceneName(joint.name))
+      .set("lower", lower)
+      .set("upper", upper)
+      .set("limit_stiffness", options_.limitStiffness)
+      .set("limit_damping", options_.limitDamping);
+}
+
 void UrdfTranslator::reportIgnored() const {
   if (!limitedJoints_.empty())
-    warn(file_.path(), "position limits of joints " + quotedList(limitedJoints_) + " are ignored (no joint stops)");
+    warn(file_.path(), "position limits of joints " + quotedList(limitedJoints_) +
+                           " are ignored (no joint stops; <urdf limits=\"true\"> adds them)");
+  if (!fullTurnLimits_.empty())
+    warn(file_.path(), "position limits of joints " + quotedList(fullTurnLimits_) +
+                           " span a full turn or more and are ignored (joint stops need a range below 2 pi)");
   if (!ignoredDynamics_.empty())
     warn(file_.path(), "damping and friction of joints " + quotedList(ignoredDynamics_) +
                            " are ignored (joint forces act on revolute, continuous and prismatic joints only)");

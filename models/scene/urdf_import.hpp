@@ -24,6 +24,12 @@ struct UrdfImportOptions {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   std::map<std::string, UrdfJointState> initial;  // by URDF joint name; the others start at 0, at rest
   std::string prefix;                             // put before every element name, so a robot can be included twice
+  // raise principal moments that violate the strict triangle inequality (with a warning) instead of failing
+  bool balanceInertia = false;
+  // stops at the position limits of revolute and prismatic joints (a <joint_force> NAME.limits each)
+  bool limits = false;
+  double limitStiffness = 1e4;  // k_s of the stops (N m/rad^2 or N/m^2)
+  double limitDamping = 5e3;    // c_s of the stops (N m s/rad^3 or N s/m^3)
 };
 
 // Validate the URDF at `path` and append its scene elements to `scene`, in an order the

@@ -81,6 +81,12 @@ UrdfImportOptions readUrdfOptions(ElementReader& in, const XMLElement& include) 
   options.position = in.vector("position", Vec3::Zero());
   options.orientation = in.orientation("orientation");
   options.prefix = in.text("prefix", "");
+  options.balanceInertia = in.flag("balance_inertia", false);
+  options.limits = in.flag("limits", false);
+  if (options.limits) {
+    options.limitStiffness = in.positive("limit_stiffness", options.limitStiffness);
+    options.limitDamping = in.nonNegative("limit_damping", 0.5 * options.limitStiffness);
+  }
   for (const XMLElement* child = include.FirstChildElement(); child; child = child->NextSiblingElement()) {
     const ElementSpec spec = toSpec(*child, in.element().where.file, 0);
     ElementReader initial(spec);
