@@ -100,7 +100,7 @@ TEST_P(EveryScene, BudgetSumsToTheHistoryTotals) {
 
 std::vector<std::string> everyScene() {
   std::vector<std::string> scenes;
-  for (const fs::path dir : {fs::path(METRIPLEX_SCENES_DIR), fs::path(METRIPLEX_SCENES_DIR) / "urdf"})
+  for (const fs::path& dir : {fs::path(METRIPLEX_SCENES_DIR), fs::path(METRIPLEX_SCENES_DIR) / "urdf"})
     for (const auto& entry : fs::directory_iterator(dir))
       if (entry.path().extension() == ".xml" || entry.path().extension() == ".urdf")
         scenes.push_back(entry.path().string());
