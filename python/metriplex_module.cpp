@@ -128,7 +128,8 @@ AttributeValue attributeOf(const std::string& name, const py::handle& value) {
 py::object run(const py::object& scene, const std::string& integrator, std::optional<double> dt,
                std::optional<double> tEnd, const std::string& out, std::optional<double> outputInterval, bool adaptive,
                std::optional<double> rtol, std::optional<double> atol, int maxOrder, bool sundialsKlu,
-               std::optional<double> dtOut, int checkpointEvery, const std::string& restart, bool budget) {
+               std::optional<double> dtOut, int checkpointEvery, const std::string& restart, bool budget,
+               bool urdfLimits) {
   RunRequest request;
   if (py::isinstance<SceneSpec>(scene)) {
     request.spec = &scene.cast<const SceneSpec&>();
@@ -150,6 +151,7 @@ py::object run(const py::object& scene, const std::string& integrator, std::opti
   request.checkpointEvery = checkpointEvery;
   request.restart = restart;
   request.budget = budget;
+  request.urdfLimits = urdfLimits;
   const Recording recording = record(request);
 
   py::dict history;
@@ -224,6 +226,7 @@ PYBIND11_MODULE(_metriplex, module) {
              py::arg("adaptive") = false, py::arg("rtol") = py::none(), py::arg("atol") = py::none(),
              py::arg("max_order") = 5, py::arg("sundials_klu") = false, py::arg("dt_out") = py::none(),
              py::arg("checkpoint_every") = 0, py::arg("restart") = "", py::arg("budget") = false,
+             py::arg("urdf_limits") = false,
              "Run a scene file (str or path) or a Scene with the options of `metriplex run` (docs/python.md). "
              "Writes files only into `out` when given. Raises InputError (a ValueError) on invalid input.");
 }

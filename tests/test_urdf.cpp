@@ -586,6 +586,16 @@ TEST_F(UrdfTest, IgnoredLimitsWarnOnlyWithoutStops) {
       metriplex("run " + quoted(write("scene.xml", limitedPendulumScene(" limits=\"true\""))) + run);
   ASSERT_EQ(with.exitCode, kExitSuccess) << with.err;
   EXPECT_EQ(with.err.find("warning"), std::string::npos) << with.err;
+  // a .urdf run directly takes them from the command line: the stops are an element of the
+  // budget, and there is no warning
+  const Invocation direct = metriplex("run " + quoted(dir_ / "limited.urdf") + " --urdf-limits --budget" + run);
+  ASSERT_EQ(direct.exitCode, kExitSuccess) << direct.err;
+  EXPECT_EQ(direct.err.find("warning"), std::string::npos) << direct.err;
+  EXPECT_NE(readFile(dir_ / "out" / "budget.csv").find(",hinge.limits,"), std::string::npos);
+  const Invocation xml =
+      metriplex("run " + quoted(write("scene.xml", limitedPendulumScene(""))) + " --urdf-limits" + run);
+  EXPECT_EQ(xml.exitCode, kExitInvalidInput);
+  EXPECT_NE(xml.err.find("only for a .urdf scene"), std::string::npos) << xml.err;
 }
 
 // A flat disk's moments 0.01 0.01 0.03 break J_3 < J_1 + J_2: balance_inertia raises the two

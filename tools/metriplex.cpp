@@ -40,6 +40,12 @@ void addSceneOptions(CLI::App* command, RunRequest& request) {
   command->add_option("--t-end", request.tEnd, "end time (default: the scene's simulation t_end)");
 }
 
+// run and compare: joint stops of a .urdf scene.
+void addUrdfLimitsOption(CLI::App* command, RunRequest& request) {
+  command->add_flag("--urdf-limits", request.urdfLimits,
+                    "a .urdf scene: joint stops at its position limits (as <urdf limits=\"true\"> in an XML scene)");
+}
+
 // Adaptive steps of the one-step integrators and the tolerances they share with IDA.
 void addToleranceOptions(CLI::App* command, RunRequest& request) {
   command->add_flag("--adaptive", request.adaptive,
@@ -72,6 +78,7 @@ int main(int argc, char** argv) {
   run->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
   addToleranceOptions(run, request);
+  addUrdfLimitsOption(run, request);
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
   run->add_flag("--sundials-klu", request.sundialsKlu,
                 "ida: factorise with SUNDIALS' KLU instead of Metriplex's sparse LU (KLU, UMFPACK for large systems)");
@@ -95,6 +102,7 @@ int main(int argc, char** argv) {
   compare->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   compare->add_option("--integrators", integrators, "comma-separated integrators")->capture_default_str();
   addToleranceOptions(compare, request);
+  addUrdfLimitsOption(compare, request);
   compare->add_option("--out", request.out, "output directory (default: out/<scene name>-compare)");
 
   BenchRequest bench;

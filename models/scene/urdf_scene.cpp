@@ -15,14 +15,14 @@ const Vec3 kUrdfSceneGravity(0.0, 0.0, -9.81);
 
 }  // namespace
 
-SceneSpec readUrdfScene(const std::string& path) {
+SceneSpec readUrdfScene(const std::string& path, const UrdfImportOptions& options) {
   SceneSpec scene;
   scene.name = std::filesystem::path(path).stem().string();
   scene.label = path;
   scene.settings.dt = kUrdfSceneStep;
   scene.settings.tEnd = kUrdfSceneEndTime;
   scene.gravity = kUrdfSceneGravity;
-  appendUrdfElements(path, UrdfImportOptions{}, scene);
+  appendUrdfElements(path, options, scene);
   return scene;
 }
 

@@ -8,6 +8,7 @@
 #include "tools/output/solid_frames.hpp"
 
 #include "engine/core/input_error.hpp"
+#include "models/scene/urdf_scene.hpp"
 
 #include <fmt/format.h>
 
@@ -59,6 +60,16 @@ void prepareCheckpoints(const RunRequest& request, PreparedRun& run) {
                                  run.resume->time, p.tEnd));
 }
 
+// The scene file, a .urdf with its joint stops if asked for.
+CompiledScene loadRequestedScene(const RunRequest& request, std::optional<ThermalVariable> variable) {
+  if (!request.urdfLimits) return loadScene(request.scene, variable);
+  if (std::filesystem::path(request.scene).extension() != ".urdf")
+    throw InputError("option --urdf-limits: only for a .urdf scene; in an XML scene write <urdf ... limits=\"true\">");
+  UrdfImportOptions options;
+  options.limits = true;
+  return compileScene(readUrdfScene(request.scene, options), variable);
+}
+
 std::string statusOf(const RunSummary& s) { return s.interrupted ? "interrupted" : s.failed ? "failed" : "ok"; }
 
 }  // namespace
@@ -78,7 +89,7 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   std::optional<Method> method;
   if (!request.integrator.empty()) method = methodOrThrow(request.integrator);
   const std::optional<ThermalVariable> variable = method ? method->thermalVariable : std::nullopt;
-  CompiledScene scene = request.spec ? compileScene(*request.spec, variable) : loadScene(request.scene, variable);
+  CompiledScene scene = request.spec ? compileScene(*request.spec, variable) : loadRequestedScene(request, variable);
   if (!method) method = methodOrThrow(scene.settings.integrator);
   checkMethodSupports(*method, *scene.model, request.scene);
 

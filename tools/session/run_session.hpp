@@ -29,6 +29,7 @@ struct RunRequest {
   // one-step schemes
   int checkpointEvery = 0;  // steps between checkpoints in DIR/checkpoint.txt (0: only at a stop request)
   std::string restart;      // a checkpoint file to continue from
+  bool urdfLimits = false;  // a .urdf scene: stops at its joints' position limits (as <urdf limits="true">)
   bool budget = false;      // DIR/budget.csv and budget.png: energy and entropy per element (one-step schemes)
 };
 
