@@ -118,19 +118,17 @@ JointForce::Penetration JointForce::penetration(const Vec3& args) const {
   const Jet offset = fromRangeMiddle(spec_.revolute, args, *spec_.stop);
   const double depth = std::abs(offset.value) - 0.5 * (spec_.stop->upper - spec_.stop->lower);
   if (!(depth > 0.0)) return {};
-  return {depth, (offset.value > 0.0 ? 1.0 : -1.0) * offset.grad};
+  const double sign = offset.value > 0.0 ? 1.0 : -1.0;
+  return {depth, sign * offset.grad, sign * offset.hess};
 }
 
 Jet JointForce::stopEnergy(const Vec3& args) const {
-  Jet jet;
   const Penetration p = penetration(args);
-  if (!(p.depth > 0.0)) return jet;
-  // V(delta) = k/3 delta^3 with delta'' the signed Hessian of the chart
-  const Jet offset = fromRangeMiddle(spec_.revolute, args, *spec_.stop);
-  const double k = spec_.stop->stiffness, sign = offset.value > 0.0 ? 1.0 : -1.0;
-  jet.value = k / 3.0 * p.depth * p.depth * p.depth;
-  jet.grad = k * p.depth * p.depth * p.grad;
-  jet.hess = 2.0 * k * p.depth * p.grad * p.grad.transpose() + sign * k * p.depth * p.depth * offset.hess;
+  const double k = spec_.stop->stiffness, d = p.depth;
+  Jet jet;
+  jet.value = k / 3.0 * d * d * d;
+  jet.grad = k * d * d * p.grad;
+  jet.hess = 2.0 * k * d * p.grad * p.grad.transpose() + k * d * d * p.hess;
   return jet;
 }
 

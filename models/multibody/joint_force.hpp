@@ -66,10 +66,11 @@ class JointForce final : public Component {
   Jet springEnergy(const Vec3& args) const;
   // Generalised dissipative force for a coordinate rate, and its derivative.
   double dissipativeForce(double rate, double* dForce) const;
-  // Depth beyond the nearer stop, and its gradient over the arguments (zero inside the range).
+  // Depth beyond the nearer stop, its gradient and Hessian over the arguments (zero inside the range).
   struct Penetration {
     double depth = 0.0;
     Vec3 grad = Vec3::Zero();
+    Mat3 hess = Mat3::Zero();
   };
   Penetration penetration(const Vec3& args) const;
   // The stop potential k_s/3 delta^3 over the arguments.
