@@ -72,7 +72,7 @@ void Assembler::clear() {
   residual_.setZero();
   std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
   flows_ = Flows{};
-  std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
+  if (keepComponentFlows_) std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }
 
 void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
@@ -100,7 +100,7 @@ void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double valu
     crossed.externalWork = reaction * conjugate;
   }
   flows_ += crossed;
-  componentFlows_.back() += crossed;
+  if (keepComponentFlows_) componentFlows_.back() += crossed;
   double* values = tangent_.valuePtr();
   for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
   values[prescribedDiagonal_[k]] = diagonal;

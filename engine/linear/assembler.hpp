@@ -78,7 +78,7 @@ class Assembler {
       for (int b = 0; b < count; ++b) {
         scatter(first + b, components[first + b]->dofs(), locals_[b], weight, withTangent);
         flows_ += localFlows_[b] * weight;
-        componentFlows_[first + b] += localFlows_[b] * weight;
+        if (keepComponentFlows_) componentFlows_[first + b] += localFlows_[b] * weight;
       }
     }
   }
@@ -88,7 +88,9 @@ class Assembler {
   const Eigen::SparseMatrix<double>& tangent() const { return tangent_; }
   const Flows& flows() const { return flows_; }
   // The flows of the last evaluation per component, in the model's order, and one more entry:
-  // the prescribed motions' reactions. They sum to flows().
+  // the prescribed motions' reactions; they sum to flows(). Kept only when asked (a budget),
+  // so that the step's evaluations do no per-component bookkeeping otherwise.
+  void keepComponentFlows(bool keep) { keepComponentFlows_ = keep; }
   const std::vector<Flows>& componentFlows() const { return componentFlows_; }
   // Row scales sum_j |K_ij| stateScale_j: the change each residual row's terms make over the
   // state's magnitude, so that rows of any unit compare alike.
@@ -122,6 +124,7 @@ class Assembler {
   Eigen::SparseMatrix<double> tangent_;
   Flows flows_;
   std::vector<Flows> componentFlows_;
+  bool keepComponentFlows_ = false;
   // per component: (local column-major entry, position in tangent_ values) of its coupled pairs
   std::vector<std::vector<std::pair<int, int>>> scatterMap_;
   std::vector<std::vector<int>> prescribedRowEntries_;  // per prescribed motion: its row in tangent_ values

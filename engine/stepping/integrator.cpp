@@ -172,6 +172,7 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
                                 std::vector<Flows>* byComponent) {
   StepOutcome outcome;
   byComponent_ = byComponent;
+  assembler_.keepComponentFlows(byComponent != nullptr);
   if (byComponent) std::fill(byComponent->begin(), byComponent->end(), Flows{});
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
   if (outcome.converged) {
