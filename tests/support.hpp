@@ -30,6 +30,8 @@ inline std::string schemeName(Scheme scheme) {
   switch (scheme) {
     case Scheme::Eem:
       return "eem";
+    case Scheme::Eem4:
+      return "eem4";
     case Scheme::Midpoint:
       return "midpoint";
     case Scheme::Trapezoidal:

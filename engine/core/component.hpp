@@ -2,6 +2,8 @@
 // The one interface every physical effect implements. A component touches a fixed list of
 // state dofs (its local dofs); the engine evaluates it on preallocated local buffers and
 // scatters the result. Energy, entropy and momenta of the system are plain sums over components.
+#include "engine/core/collocation_rule.hpp"
+
 #include <Eigen/Dense>
 
 #include <string>
@@ -47,6 +49,27 @@ struct RateArgs {
   double t;
   double alpha;
   double beta;
+};
+
+// One stage of a Gauss collocation step (eem4) from zOld at t over dt: the state's polynomial
+// passes through zOld and the stage values; stageState[l] and stageRate[l] are z and z' at
+// t + c_l dt, zEnd is z(t + dt). Wanted: the residual of stage `stage` and its derivative with
+// respect to the values of stage `column`.
+struct StageArgs {
+  const CollocationRule* rule;
+  const double* zOld;
+  const double* zEnd;
+  const double* const* stageState;
+  const double* const* stageRate;
+  double t;
+  double dt;
+  int stage;
+  int column;
+  // The rate form at this stage, with the coefficients of the tangent for stage `column`.
+  RateArgs rateArgs() const {
+    return {stageState[stage], stageRate[stage], t + rule->node[stage] * dt, stage == column ? 1.0 : 0.0,
+            rule->rate[stage][column + 1] / dt};
+  }
 };
 
 // Power crossing the system boundary or leaving the mechanical energy (W): viscous power
@@ -116,6 +139,14 @@ class Component {
   virtual void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const = 0;
   // Continuous residual F(t, z, zdot) and alpha dF/dz + beta dF/dzdot.
   virtual void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const = 0;
+
+  // How the component enters an eem4 step. Its rate form at each stage keeps the balances when
+  // its energy is quadratic in the state or absent (RateAtStages); a non-quadratic energy needs
+  // an energy-consistent form of its own (Own: stageLocal). None: eem4 refuses the scene.
+  enum class StageForm { None, RateAtStages, Own };
+  virtual StageForm stageForm() const { return StageForm::None; }
+  virtual void stageLocal(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem& /*out*/,
+                          Flows& /*flows*/) const {}
 
  protected:
   Component(std::string name, std::vector<int> dofs) : name_(std::move(name)), dofs_(std::move(dofs)) {}

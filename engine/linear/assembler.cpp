@@ -12,47 +12,56 @@
 
 namespace mpx {
 
-Assembler::Assembler(const Model& model) {
-  const int n = model.layout().total();
-  residual_ = Eigen::VectorXd::Zero(n);
-  rowScale_ = Eigen::VectorXd::Zero(n);
+Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(model.layout().total()) {
+  const int n = size_, unknowns = stages * n;
+  residual_ = Eigen::VectorXd::Zero(unknowns);
+  rowScale_ = Eigen::VectorXd::Zero(unknowns);
 
-  // pattern: the coupled pairs of each component's dofs, plus the diagonal
+  // pattern: the coupled pairs of each component's dofs, plus the diagonal, in every block
   std::vector<Eigen::Triplet<double>> entries;
-  for (int i = 0; i < n; ++i) entries.emplace_back(i, i, 0.0);
+  for (int i = 0; i < unknowns; ++i) entries.emplace_back(i, i, 0.0);
   for (const auto& component : model.components()) {
     const auto& dofs = component->dofs();
     if (dofs.size() > static_cast<std::size_t>(kMaxLocalDofs))
       throw std::logic_error("component '" + component->name() + "' touches more than kMaxLocalDofs dofs");
-    for (std::size_t i = 0; i < dofs.size(); ++i)
-      for (std::size_t j = 0; j < dofs.size(); ++j)
-        if (component->couples(static_cast<int>(i), static_cast<int>(j))) entries.emplace_back(dofs[i], dofs[j], 0.0);
+    for (int rowStage = 0; rowStage < stages; ++rowStage)
+      for (int columnStage = 0; columnStage < stages; ++columnStage)
+        for (std::size_t i = 0; i < dofs.size(); ++i)
+          for (std::size_t j = 0; j < dofs.size(); ++j)
+            if (component->couples(static_cast<int>(i), static_cast<int>(j)))
+              entries.emplace_back(dofs[i] + rowStage * n, dofs[j] + columnStage * n, 0.0);
   }
-  tangent_.resize(n, n);
+  tangent_.resize(unknowns, unknowns);
   tangent_.setFromTriplets(entries.begin(), entries.end());
   tangent_.makeCompressed();
 
-  // scatter map: position of (row, col) in the compressed column `col`
-  const int* outer = tangent_.outerIndexPtr();
-  const int* inner = tangent_.innerIndexPtr();
+  // scatter maps: position of (row, col) of each block in the compressed column `col`
   for (const auto& component : model.components()) {
     const auto& dofs = component->dofs();
-    std::vector<std::pair<int, int>> map;
-    for (std::size_t j = 0; j < dofs.size(); ++j)
-      for (std::size_t i = 0; i < dofs.size(); ++i) {
-        if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
-        map.emplace_back(static_cast<int>(i + j * dofs.size()), findEntry(tangent_, dofs[i], dofs[j]));
+    for (int rowStage = 0; rowStage < stages; ++rowStage)
+      for (int columnStage = 0; columnStage < stages; ++columnStage) {
+        std::vector<std::pair<int, int>> map;
+        for (std::size_t j = 0; j < dofs.size(); ++j)
+          for (std::size_t i = 0; i < dofs.size(); ++i) {
+            if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
+            map.emplace_back(static_cast<int>(i + j * dofs.size()),
+                             findEntry(tangent_, dofs[i] + rowStage * n, dofs[j] + columnStage * n));
+          }
+        scatterMap_.push_back(std::move(map));
       }
-    scatterMap_.push_back(std::move(map));
   }
-  // rows of the prescribed velocities, to be overwritten
+  // rows of the prescribed motions at every stage, to be overwritten
   const auto& prescribed = model.prescribedMotions();
-  prescribedRowEntries_.assign(prescribed.size(), {});
-  std::vector<int> prescribedIndex(n, -1);
-  for (std::size_t k = 0; k < prescribed.size(); ++k) prescribedIndex[prescribed[k].dof] = static_cast<int>(k);
-  for (int e = 0; e < outer[n]; ++e)
-    if (prescribedIndex[inner[e]] >= 0) prescribedRowEntries_[prescribedIndex[inner[e]]].push_back(e);
-  for (const PrescribedMotion& p : prescribed) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof, p.dof));
+  prescribedRowEntries_.assign(prescribed.size() * stages, {});
+  std::vector<int> prescribedRow(unknowns, -1);
+  for (std::size_t k = 0; k < prescribed.size(); ++k)
+    for (int l = 0; l < stages; ++l) prescribedRow[prescribed[k].dof + l * n] = static_cast<int>(k) * stages + l;
+  const int* outer = tangent_.outerIndexPtr();
+  const int* inner = tangent_.innerIndexPtr();
+  for (int e = 0; e < outer[unknowns]; ++e)
+    if (prescribedRow[inner[e]] >= 0) prescribedRowEntries_[prescribedRow[inner[e]]].push_back(e);
+  for (const PrescribedMotion& p : prescribed)
+    for (int l = 0; l < stages; ++l) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof + l * n, p.dof + l * n));
   const auto& components = model.components();
   firstCoupling_ = std::partition_point(components.begin(), components.end(),
                                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); }) -
@@ -75,21 +84,27 @@ void Assembler::clear() {
   if (keepComponentFlows_) std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }
 
-void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
-                        bool withTangent) {
+void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
+                        const Pass& pass) {
   assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
-  double* values = tangent_.valuePtr();
-  for (int i = 0; i < local.n; ++i) {
-    residual_[dofs[i]] += weight * local.r[i];
-    if (!std::isfinite(local.r[i]) && firstNonFinite_.component < 0)
-      firstNonFinite_ = {static_cast<int>(component), dofs[i]};
+  if (pass.withResidual) {
+    const int rowOffset = pass.block / stages_ * size_;
+    for (int i = 0; i < local.n; ++i) {
+      residual_[dofs[i] + rowOffset] += pass.weight * local.r[i];
+      if (!std::isfinite(local.r[i]) && firstNonFinite_.component < 0)
+        firstNonFinite_ = {static_cast<int>(component), dofs[i]};
+    }
   }
-  if (!withTangent) return;
-  for (const auto& [localEntry, value] : scatterMap_[component]) values[value] += weight * local.k[localEntry];
+  if (!pass.withTangent) return;
+  double* values = tangent_.valuePtr();
+  for (const auto& [localEntry, value] : scatterMap_[component * stages_ * stages_ + pass.block])
+    values[value] += pass.weight * local.k[localEntry];
 }
 
-void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate) {
-  const double reaction = residual_[p.dof];
+void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate,
+                           int stage, double weight) {
+  const int row = p.dof + stage * size_;
+  const double reaction = residual_[row];
   // a prescribed temperature's reaction is the heat it supplies, which brings entropy at that
   // temperature (`conjugate` holds it); a prescribed velocity's reaction does work
   Flows crossed;
@@ -99,12 +114,47 @@ void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double valu
   } else {
     crossed.externalWork = reaction * conjugate;
   }
-  flows_ += crossed;
-  if (keepComponentFlows_) componentFlows_.back() += crossed;
+  flows_ += crossed * weight;
+  if (keepComponentFlows_) componentFlows_.back() += crossed * weight;
   double* values = tangent_.valuePtr();
-  for (int e : prescribedRowEntries_[k]) values[e] = 0.0;
-  values[prescribedDiagonal_[k]] = diagonal;
-  residual_[p.dof] = value;
+  const std::size_t slot = k * stages_ + stage;
+  for (int e : prescribedRowEntries_[slot]) values[e] = 0.0;
+  values[prescribedDiagonal_[slot]] = diagonal;
+  residual_[row] = value;
+}
+
+void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
+  // the rate form at the stages, or a component's own energy-consistent stage form
+  auto evaluate = [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) {
+    if (c.stageForm() == Component::StageForm::Own)
+      c.stageLocal(args, w, l, f);
+    else
+      c.rateLocal(args.rateArgs(), w, l, f);
+  };
+  // each stage row block with its own stage's columns first: that pass gives the residual
+  for (args.stage = 0; args.stage < stages_; ++args.stage)
+    for (int offset = 0; offset < stages_; ++offset) {
+      args.column = (args.stage + offset) % stages_;
+      add(model, ws, {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, true},
+          evaluate);
+    }
+}
+
+void Assembler::imposeStageMotions(const Model& model, const StageArgs& args) {
+  const auto& prescribed = model.prescribedMotions();
+  for (int l = 0; l < stages_; ++l) {
+    const double* z = args.stageState[l];
+    const double t = args.t + args.rule->node[l] * args.dt;
+    for (std::size_t k = 0; k < prescribed.size(); ++k) {
+      const PrescribedMotion& p = prescribed[k];
+      // a velocity or temperature follows the profile's change since the step's start, as in
+      // the one-stage steps; a displacement gives the velocity as its slope
+      const double value = p.kind == PrescribedKind::Displacement
+                               ? z[p.dof] - p.amplitude * p.profile.slope(t)
+                               : z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
+      replaceRow(k, p, value, 1.0, z[p.dof], l, args.rule->weight[l]);
+    }
+  }
 }
 
 void Assembler::imposeStepMotions(const Model& model, const double* zOld, const double* zNew, double t, double dt) {

@@ -18,7 +18,10 @@ namespace mpx {
 
 class Assembler {
  public:
-  explicit Assembler(const Model& model);
+  // `stages` > 1: the system of an eem4 step, whose unknowns are the values of each stage
+  // (stage l's dof i at l n + i) and whose tangent has one block of the model's pattern per
+  // pair of stages.
+  explicit Assembler(const Model& model, int stages = 1);
   // The local systems point into the assembler's own buffers.
   Assembler(const Assembler&) = delete;
   Assembler& operator=(const Assembler&) = delete;
@@ -27,7 +30,7 @@ class Assembler {
   void clear();
   // Add every component's EEM step residual and tangent.
   void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
-    add(model, ws, 1.0, true,
+    add(model, ws, {0, 1.0, 1.0, true, true},
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
   }
   // Replace the rows of prescribed motions for the step zOld -> zNew: v' = V(t + dt) (tangent
@@ -40,21 +43,36 @@ class Assembler {
   // evaluations of weight 1/2). With alpha = beta = 0 only the residual is wanted (IDA's
   // residual calls): the tangent is left at zero.
   void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
-    add(model, ws, weight, args.alpha != 0.0 || args.beta != 0.0,
+    add(model, ws, {0, weight, weight, true, args.alpha != 0.0 || args.beta != 0.0},
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
   }
+  // Add every stage's residual (its flows weighted b_l) and the tangent blocks of all pairs
+  // of stages: one evaluation of every component per pair.
+  void addStages(const Model& model, Workspace& ws, StageArgs args);
+  // Prescribed motions at every stage: v_l = V'(t_l) or the temperature, tangent 1.
+  void imposeStageMotions(const Model& model, const StageArgs& args);
 
  private:
+  // Where one evaluation goes: the tangent block (stage rows, stage columns; 0 for one-stage
+  // systems), the weights of its residual and tangent and of its flows, whether the residual
+  // and the tangent are wanted.
+  struct Pass {
+    int block;
+    double weight;
+    double flowWeight;
+    bool withResidual;
+    bool withTangent;
+  };
   // Evaluate every component with evaluate(component, workspace, local, flows) and add the
-  // result times `weight`.
+  // result as `pass` says.
   template <class Evaluate>
-  void add(const Model& model, Workspace& ws, double weight, bool withTangent, const Evaluate& evaluate) {
+  void add(const Model& model, Workspace& ws, const Pass& pass, const Evaluate& evaluate) {
     // couplings read the node temperatures their owners publish: all owners come first
-    addRange(model, 0, firstCoupling_, ws, weight, withTangent, evaluate);
-    addRange(model, firstCoupling_, model.components().size(), ws, weight, withTangent, evaluate);
+    addRange(model, 0, firstCoupling_, ws, pass, evaluate);
+    addRange(model, firstCoupling_, model.components().size(), ws, pass, evaluate);
   }
   template <class Evaluate>
-  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, double weight, bool withTangent,
+  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, const Pass& pass,
                 const Evaluate& evaluate) {
     const auto& components = model.components();
     for (std::size_t first = begin; first < end; first += kBatch) {
@@ -76,9 +94,10 @@ class Assembler {
         for (int b = 0; b < count; ++b) evaluateSlot(b);
       }
       for (int b = 0; b < count; ++b) {
-        scatter(first + b, components[first + b]->dofs(), locals_[b], weight, withTangent);
-        flows_ += localFlows_[b] * weight;
-        if (keepComponentFlows_) componentFlows_[first + b] += localFlows_[b] * weight;
+        scatter(first + b, components[first + b]->dofs(), locals_[b], pass);
+        if (!pass.withResidual) continue;
+        flows_ += localFlows_[b] * pass.flowWeight;
+        if (keepComponentFlows_) componentFlows_[first + b] += localFlows_[b] * pass.flowWeight;
       }
     }
   }
@@ -114,9 +133,10 @@ class Assembler {
   // Prescribed motion k: its row becomes `value` with `diagonal` as the only tangent entry;
   // the reaction (the row's residual before) does work at velocity `conjugate`, or, for a
   // temperature, is heat that enters at temperature `conjugate`.
-  void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate);
-  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, double weight,
-               bool withTangent);
+  // At stage `stage` of a multi-stage system, with the reaction's flows times `weight`.
+  void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate,
+                  int stage = 0, double weight = 1.0);
+  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, const Pass& pass);
 
   NonFiniteEntry firstNonFinite_;
   Eigen::VectorXd residual_;
@@ -125,9 +145,13 @@ class Assembler {
   Flows flows_;
   std::vector<Flows> componentFlows_;
   bool keepComponentFlows_ = false;
-  // per component: (local column-major entry, position in tangent_ values) of its coupled pairs
+  int stages_ = 1;
+  int size_ = 0;  // of the model's state: the offset from one stage's unknowns to the next
+  // per component and tangent block (component stages^2 + rowStage stages + columnStage):
+  // (local column-major entry, position in tangent_ values) of its coupled pairs
   std::vector<std::vector<std::pair<int, int>>> scatterMap_;
-  std::vector<std::vector<int>> prescribedRowEntries_;  // per prescribed motion: its row in tangent_ values
+  // per prescribed motion and stage (k stages + l): its row, and its diagonal, in tangent_ values
+  std::vector<std::vector<int>> prescribedRowEntries_;
   std::vector<int> prescribedDiagonal_;
   // Components per batch, and the smallest batch evaluated in parallel (below it, starting the
   // threads costs more than they save: docs/performance.md, "Parallel assembly").

@@ -9,15 +9,19 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 }  // namespace
 
 CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : pattern_(&pattern) {
-  // positions come first in the layout, velocities right after, dof for dof
-  const bool paired = layout.has(Block::Position) && layout.size(Block::Position) == layout.size(Block::Velocity) &&
+  // positions come first in the layout, velocities right after, dof for dof; the system of
+  // several stages (eem4) is solved whole
+  const bool oneStage = pattern.rows() == layout.total();
+  if (!oneStage) wholeSystemReason_ = "it is the stage system of a collocation step";
+  const bool paired = oneStage && layout.has(Block::Position) &&
+                      layout.size(Block::Position) == layout.size(Block::Velocity) &&
                       layout.offset(Block::Position) == 0;
   velocities_ = paired ? layout.size(Block::Velocity) : 0;
   if (velocities_ > 0 && !buildCondensation(pattern)) velocities_ = 0;
   reducedRhs_.resize(pattern.rows() - velocities_);
   // internal variables, numbered as in the velocity-condensed system
   const SparseMatrix& stage = velocities_ > 0 ? reduced_ : pattern;
-  internal_.build(stage, layout.offset(Block::Internal) - velocities_, layout.size(Block::Internal));
+  internal_.build(stage, layout.offset(Block::Internal) - velocities_, oneStage ? layout.size(Block::Internal) : 0);
   internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
   internalSolution_.resize(stage.rows());
   lu_ = makeSparseLu(static_cast<int>(factorised().rows()));

@@ -14,20 +14,34 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
     : model_(model),
       scheme_(scheme),
       settings_(settings),
-      assembler_(model),
+      rule_(gaussCollocation(scheme == Scheme::Eem4 ? 2 : 1)),
+      assembler_(model, rule_.stages),
       solver_(model.layout(), assembler_.tangent()),
       workspace_(model.makeWorkspace()),
       zMid_(model.layout().total()),
       zDot_(model.layout().total()),
-      increment_(model.layout().total()),
-      trial_(model.layout().total()),
-      unknownsWithScale_(model.layout().offset(Block::Multiplier)),
+      increment_(rule_.stages * model.layout().total()),
+      trial_(rule_.stages * model.layout().total()),
       halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())),
       lastStart_(model.layout().total()),
-      lastEnd_(model.layout().total()) {}
+      lastEnd_(model.layout().total()) {
+  const int n = model.layout().total(), withScale = model.layout().offset(Block::Multiplier);
+  unknownScale_ = model.dofScale().replicate(rule_.stages, 1);
+  incrementScale_ = unknownScale_;
+  for (int l = 0; l < rule_.stages; ++l) incrementScale_.segment(l * n + withScale, n - withScale).setConstant(INFINITY);
+  if (scheme == Scheme::Eem4) {
+    stages_.resize(rule_.stages * n);
+    stageRates_.resize(rule_.stages * n);
+    stageEnd_.resize(n);
+  }
+}
 
 Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
   assembler_.clear();
+  if (scheme_ == Scheme::Eem4) {
+    addStages(zOld, zNew, t, dt);
+    return assembler_;
+  }
   if (scheme_ == Scheme::Eem) {
     assembler_.addStep(model_, workspace_, {zOld.data(), zNew.data(), t, dt});
   } else {
@@ -50,9 +64,42 @@ void Integrator::addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd&
   assembler_.addRate(model_, workspace_, {zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
 }
 
+void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt) {
+  const int n = static_cast<int>(zOld.size());
+  const double* state[CollocationRule::kMostStages] = {};
+  const double* rate[CollocationRule::kMostStages] = {};
+  endOfStages(zOld, stages, stageEnd_);
+  for (int l = 0; l < rule_.stages; ++l) {
+    auto stageRate = stageRates_.segment(l * n, n);
+    stageRate = (rule_.rate[l][0] / dt) * zOld;
+    for (int j = 0; j < rule_.stages; ++j) stageRate += (rule_.rate[l][j + 1] / dt) * stages.segment(j * n, n);
+    state[l] = stages.data() + l * n;
+    rate[l] = stageRates_.data() + l * n;
+  }
+  const StageArgs args{&rule_, zOld.data(), stageEnd_.data(), state, rate, t, dt, 0, 0};
+  assembler_.addStages(model_, workspace_, args);
+  assembler_.imposeStageMotions(model_, args);
+}
+
 bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
                            StepOutcome& outcome) {
-  const Eigen::VectorXd& scale = model_.dofScale();
+  if (rule_.stages == 1) return solveUnknowns(zOld, t, dt, zNew, outcome);
+  // the stages start on the line from the old state to the guessed end state
+  const int n = static_cast<int>(zOld.size());
+  for (int l = 0; l < rule_.stages; ++l) stages_.segment(l * n, n) = zOld + rule_.node[l] * (zNew - zOld);
+  if (!solveUnknowns(zOld, t, dt, stages_, outcome)) return false;
+  endOfStages(zOld, stages_, zNew);
+  return true;
+}
+
+void Integrator::endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const {
+  const int n = static_cast<int>(zOld.size());
+  zEnd = rule_.end[0] * zOld;
+  for (int l = 0; l < rule_.stages; ++l) zEnd += rule_.end[l + 1] * stages.segment(l * n, n);
+}
+
+bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
+                               StepOutcome& outcome) {
   // a failure names the component and dof whose residual went non-finite in this step, if any
   assembler_.forgetNonFinite();
   auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
@@ -64,7 +111,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   };
   // the residual norm relative to row scales taken at the current iterate
   auto rescaledNorm = [&](Assembler& system) {
-    stateScale_ = zNew.cwiseAbs() + scale;
+    stateScale_ = zNew.cwiseAbs() + unknownScale_;
     system.updateRowScale(stateScale_);
     return system.relativeResidualNorm();
   };
@@ -73,7 +120,7 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
   Assembler& system = evaluate(zOld, zNew, t, dt);
   double residualNorm = rescaledNorm(system);
   if (!std::isfinite(residualNorm)) {
-    zNew = zOld;
+    zNew = zOld.replicate(rule_.stages, 1);
     evaluate(zOld, zNew, t, dt);
     residualNorm = rescaledNorm(system);
   }
@@ -108,11 +155,8 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
     }
     zNew.swap(trial_);
     ++outcome.iterations;
-    // multipliers have no natural scale; their rows' residual (the constraints) judges them
     const double previousIncrementNorm = incrementNorm;
-    incrementNorm = step * (increment_.head(unknownsWithScale_).array().abs() /
-                            (zNew.head(unknownsWithScale_).array().abs() + scale.head(unknownsWithScale_).array()))
-                               .maxCoeff();
+    incrementNorm = step * (increment_.array().abs() / (zNew.array().abs() + incrementScale_.array())).maxCoeff();
     residualNorm = rescaledNorm(system);
     // keep the factorisation while the iteration contracts well (or has converged); full Newton
     // keeps it too once the increment is small: a tangent taken that close to the solution

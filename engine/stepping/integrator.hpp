@@ -1,8 +1,8 @@
 #pragma once
-// One-step integrators on a compiled model: the EEM discrete-gradient scheme and the standard
-// implicit midpoint and trapezoidal rules (derived from the components' rate form), solved by
-// Newton-Raphson with the consistent tangent, a backtracking line search on the residual and
-// a bounded step cut-back.
+// One-step integrators on a compiled model: the EEM discrete-gradient scheme, its fourth-order
+// energy-consistent Gauss collocation (eem4), and the standard implicit midpoint and trapezoidal
+// rules (derived from the components' rate form), solved by Newton-Raphson with the consistent
+// tangent, a backtracking line search on the residual and a bounded step cut-back.
 #include "engine/core/model.hpp"
 #include "engine/linear/assembler.hpp"
 #include "engine/linear/condensed_solver.hpp"
@@ -17,7 +17,12 @@
 
 namespace mpx {
 
-enum class Scheme { Eem, Midpoint, Trapezoidal };
+// Eem4: two-stage Gauss collocation with energy-consistent stage gradients (docs/theory.md
+// section 12), whose Newton unknowns are the values at both stages.
+enum class Scheme { Eem, Eem4, Midpoint, Trapezoidal };
+
+// The order of a scheme's local truncation error minus one (its global order).
+inline int schemeOrder(Scheme scheme) { return scheme == Scheme::Eem4 ? 4 : 2; }
 
 struct NewtonSettings {
   double incrementTolerance = 1e-10;  // max |dz_i| / (|z_i| + scale_i)
@@ -67,8 +72,12 @@ class Integrator {
   void checkpoint(LoopState& out);
   void resume(const LoopState& saved);
 
-  // Residual and tangent of the step zOld -> zNew (exposed for tangent tests).
-  Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
+  // Residual and tangent of the step from zOld with Newton unknowns `unknowns`: the end state
+  // for one-stage schemes, the stage values one after the other for eem4 (exposed for tangent
+  // tests).
+  Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& unknowns, double t, double dt);
+  // Newton unknowns of the step: the end state, or (eem4) stageCount() stage values.
+  int stageCount() const { return rule_.stages; }
   Scheme scheme() const { return scheme_; }
   const CondensedSolver& linearSolver() const { return solver_; }
 
@@ -77,8 +86,14 @@ class Integrator {
   void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
-  // Newton from the initial guess in zNew.
+  // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess).
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
+  bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns,
+                     StepOutcome& outcome);
+  // eem4: the stage rates and the end state of the stage polynomial, then its residual.
+  void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt);
+  // z(t + dt) of the stage polynomial.
+  void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
   // Factorise the tangent of the last evaluation; false if singular.
   bool refactorize(double dt, bool repivot, StepOutcome& outcome);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
@@ -88,11 +103,15 @@ class Integrator {
   const Model& model_;
   Scheme scheme_;
   NewtonSettings settings_;
+  CollocationRule rule_;  // eem4's; one stage otherwise
   Assembler assembler_;
   CondensedSolver solver_;
   Workspace workspace_;
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
-  int unknownsWithScale_;                   // dofs before the multiplier block: those in the increment test
+  // per Newton unknown: its dof's scale, and the same with multipliers at infinity (multipliers
+  // have no natural scale; their rows' residual, the constraints, judges them)
+  Eigen::VectorXd unknownScale_, incrementScale_;
+  Eigen::VectorXd stages_, stageRates_, stageEnd_;  // eem4
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
   // simplified Newton: the step size the factorisation belongs to (0: none held)
   double factorizedDt_ = 0.0;

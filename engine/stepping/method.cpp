@@ -12,6 +12,7 @@ std::optional<Method> fixedStepMethod(const std::string& name) {
   if (name == "eem") return Method{name, Scheme::Eem, std::nullopt};
   if (name == "eem-entropy") return Method{name, Scheme::Eem, ThermalVariable::Entropy};
   if (name == "eem-temperature") return Method{name, Scheme::Eem, ThermalVariable::Temperature};
+  if (name == "eem4") return Method{name, Scheme::Eem4, std::nullopt};
   if (name == "midpoint") return Method{name, Scheme::Midpoint, std::nullopt};
   if (name == "trapezoidal") return Method{name, Scheme::Trapezoidal, std::nullopt};
   return std::nullopt;
@@ -30,6 +31,13 @@ std::optional<Method> methodByName(const std::string& name) {
 }
 
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene) {
+  if (method.scheme == Scheme::Eem4)
+    for (const auto& component : model.components())
+      if (component->stageForm() == Component::StageForm::None)
+        throw InputError(scene + ": integrator '" + method.name + "' has no fourth-order form for element '" +
+                         component->name() +
+                         "' yet (eem4 covers masses, springs, thermo-springs, Maxwell elements, dampers, heat links, "
+                         "reservoirs, fixed temperatures, forces and actuators; docs/theory.md section 12)");
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.kind == PrescribedKind::Displacement)

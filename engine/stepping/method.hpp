@@ -1,6 +1,7 @@
 #pragma once
 // Integration methods by name, and one entry point that runs any of them on a model:
-// EEM (with the scene's or a forced thermal variable), implicit midpoint, trapezoidal, IDA.
+// EEM (with the scene's or a forced thermal variable), fourth-order EEM (eem4), implicit
+// midpoint, trapezoidal, IDA.
 #include "engine/core/model.hpp"
 #include "engine/stepping/adaptive_simulation.hpp"
 #include "engine/stepping/ida_simulation.hpp"
@@ -24,7 +25,7 @@ struct Method {
 // The names methodByName accepts, for messages; each one-step name also takes the suffix
 // "-adaptive" (eem-adaptive, midpoint-adaptive, ...).
 inline constexpr const char* kMethodNames =
-    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal (each also as NAME-adaptive), ida";
+    "eem, eem-entropy, eem-temperature, eem4, midpoint, trapezoidal (each also as NAME-adaptive), ida";
 std::optional<Method> methodByName(const std::string& name);
 
 struct MethodParameters {
@@ -41,9 +42,9 @@ struct MethodParameters {
   bool componentFlows = false;      // one-step schemes: StepRecord::componentCrossed
 };
 
-// Throw InputError if `method` cannot integrate `model`: IDA needs every prescribed motion as a
-// velocity (a displacement is imposed step by step through the mean velocity, which a rate form
-// cannot express).
+// Throw InputError if `method` cannot integrate `model`: eem4 needs every component to have a
+// stage form; IDA needs every prescribed motion as a velocity (a displacement is imposed step by
+// step through the mean velocity, which a rate form cannot express).
 // `scene` names the scene file in the message.
 void checkMethodSupports(const Method& method, const Model& model, const std::string& scene);
 

@@ -17,6 +17,8 @@ class Damper final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: no energy: its power is dissipated at each stage
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   TwoPointGeometry geometry_;

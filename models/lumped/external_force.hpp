@@ -13,6 +13,8 @@ class ExternalForce final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: no energy: its power is external work at each stage
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   // Residual -F(t) on the momentum rows and the power F(t) . velocity.

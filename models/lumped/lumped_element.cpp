@@ -49,20 +49,27 @@ LocalRow LumpedElement::chain(const Vec3& dArguments, const LocalRow (&rows)[3])
   return dArguments[0] * rows[0] + dArguments[1] * rows[1] + dArguments[2] * rows[2];
 }
 
-LumpedElement::Response LumpedElement::respond(const DiscreteGradient& dEnergy,
-                                               const DiscreteGradient& dEntropy) const {
+GradientRows LumpedElement::alongRows(const DiscreteGradient& gradient, const LocalRow (&rows)[3]) {
+  GradientRows out;
+  out.grad = gradient.grad;
+  for (int i = 0; i < 3; ++i) out.d[i] = chain(gradient.dGradDb.row(i).transpose(), rows);
+  return out;
+}
+
+LumpedElement::Response LumpedElement::respond(const GradientRows& dEnergy, const GradientRows& dEntropy) const {
+  const int n = static_cast<int>(dEnergy.d[0].size());
   Response r;
+  r.dTheta = r.dViscosity = LocalRow::Zero(n);
   // discrete temperature: D_s e / D_s eta
   if (mask_ & kThermalBit) {
     r.theta = dEnergy.grad[1] / dEntropy.grad[1];
-    r.dTheta = (dEnergy.dGradDb.row(1) - r.theta * dEntropy.dGradDb.row(1)).transpose() / dEntropy.grad[1];
+    r.dTheta = (dEnergy.d[1] - r.theta * dEntropy.d[1]) / dEntropy.grad[1];
   }
   // conjugate force of c and viscous driving force of gamma, from the free energy
   r.force = dEnergy.grad[0] - r.theta * dEntropy.grad[0];
-  r.dForce = (dEnergy.dGradDb.row(0) - r.theta * dEntropy.dGradDb.row(0)).transpose() - dEntropy.grad[0] * r.dTheta;
+  r.dForce = dEnergy.d[0] - r.theta * dEntropy.d[0] - dEntropy.grad[0] * r.dTheta;
   r.drivingForce = -(dEnergy.grad[2] - r.theta * dEntropy.grad[2]);
-  r.dDrivingForce =
-      -(dEnergy.dGradDb.row(2) - r.theta * dEntropy.dGradDb.row(2)).transpose() + dEntropy.grad[2] * r.dTheta;
+  r.dDrivingForce = -(dEnergy.d[2] - r.theta * dEntropy.d[2]) + dEntropy.grad[2] * r.dTheta;
   // viscosity at the (discrete) temperature
   const Viscosity& v = spec_.viscosity;
   r.viscosity = v.reference;
@@ -73,32 +80,31 @@ LumpedElement::Response LumpedElement::respond(const DiscreteGradient& dEnergy,
   return r;
 }
 
-void LumpedElement::addBalances(const Response& response, const LocalRow (&rows)[3], double zCoefficient,
-                                const Vec3& forceDirection, double gammaRate, double entropyRate, Workspace& ws,
-                                LocalSystem& out, Flows& flows) const {
+void LumpedElement::addBalances(const Response& response, double zCoefficient, const Vec3& forceDirection,
+                                double gammaRate, double entropyRate, Workspace& ws, LocalSystem& out,
+                                Flows& flows) const {
   auto r = out.residual();
   auto K = out.tangent();
   if (geometry_) {
     geometry_->addForce(out, response.force * forceDirection);
-    geometry_->addForceTangent(out, forceDirection, zCoefficient * chain(response.dForce, rows));
+    geometry_->addForceTangent(out, forceDirection, zCoefficient * response.dForce);
   }
   const double g = response.drivingForce, nu = response.viscosity;
-  const LocalRow dDissipation =
-      chain((2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity, rows);
+  const LocalRow dDissipation = (2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity;
   if (localInternal_ >= 0) {
     r[localInternal_] += nu * gammaRate - g;
-    K.row(localInternal_) += zCoefficient * chain(gammaRate * response.dViscosity - response.dDrivingForce, rows);
+    K.row(localInternal_) += zCoefficient * (gammaRate * response.dViscosity - response.dDrivingForce);
   }
   if (localThermal_ >= 0) {
     // the viscous power heats the element's own node
     const double heating = localInternal_ >= 0 ? g * g / nu : 0.0;
     r[localThermal_] += response.theta * entropyRate - heating;
-    K.row(localThermal_) += zCoefficient * (entropyRate * chain(response.dTheta, rows) -
-                                            (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
+    K.row(localThermal_) +=
+        zCoefficient * (entropyRate * response.dTheta - (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
     NodeTemperature& node = ws.nodes[spec_.thermalNode];
     node.value = response.theta;
     node.count = out.n;
-    Eigen::Map<LocalRow>(node.grad, out.n) = zCoefficient * chain(response.dTheta, rows);
+    Eigen::Map<LocalRow>(node.grad, out.n) = zCoefficient * response.dTheta;
   } else if (localInternal_ >= 0) {
     flows.dissipated += g * g / nu;
   }
@@ -113,18 +119,18 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
                                             : partitionedGradient(energy, mask_, a, b, spec_.argumentScale);
   const DiscreteGradient dEntropy = gonzalez ? gonzalezGradient(entropy, mask_, a, b, spec_.argumentScale)
                                              : partitionedGradient(entropy, mask_, a, b, spec_.argumentScale);
-  const Response response = respond(dEnergy, dEntropy);
 
   // derivatives of the end-point arguments b with respect to zNew
   LocalRow rows[3];
   Vec3 separationMid = Vec3::Zero();
   if (geometry_) separationMid = 0.5 * (geometry_->separation(args.zOld) + geometry_->separation(args.zNew));
   argumentRows(geometry_ ? geometry_->separation(args.zNew) : Vec3::Zero(), rows);
+  const Response response = respond(alongRows(dEnergy, rows), alongRows(dEntropy, rows));
 
   const Jet entropyNew = entropy(b);
   const double gammaRate = (b[2] - a[2]) / args.dt;
   const double entropyRate = (entropyNew.value - entropy(a).value) / args.dt;
-  addBalances(response, rows, 1.0, 2.0 * separationMid, gammaRate, entropyRate, ws, out, flows);
+  addBalances(response, 1.0, 2.0 * separationMid, gammaRate, entropyRate, ws, out, flows);
 
   // terms from the explicit dependence on zNew: force direction 2 d_mid, gamma' and eta'
   auto K = out.tangent();
@@ -137,17 +143,17 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
   const Vec3 a = arguments(args.z);
   const Jet energy = spec_.law->energy(a);
   const Jet entropy = spec_.law->entropy(a);
-  const Response response = respond(exactGradient(energy), exactGradient(entropy));
 
   LocalRow rows[3];
   const Vec3 separation = geometry_ ? geometry_->separation(args.z) : Vec3::Zero();
   argumentRows(separation, rows);
+  const Response response = respond(alongRows(exactGradient(energy), rows), alongRows(exactGradient(entropy), rows));
   // argument rates: c' = 2 d . d', s', gamma'
   const Vec3 separationRate = geometry_ ? geometry_->separationRate(args.zdot) : Vec3::Zero();
   const Vec3 argumentRate(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? args.zdot[spec_.thermalDof] : 0.0,
                           localInternal_ >= 0 ? args.zdot[spec_.internalDof] : 0.0);
   const double entropyRate = entropy.grad.dot(argumentRate);
-  addBalances(response, rows, args.alpha, 2.0 * separation, argumentRate[2], entropyRate, ws, out, flows);
+  addBalances(response, args.alpha, 2.0 * separation, argumentRate[2], entropyRate, ws, out, flows);
 
   // explicit dependence on z (force direction, c' through d) and on zdot (the rates)
   auto K = out.tangent();
@@ -160,6 +166,62 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
     K.row(localThermal_) += args.alpha * response.theta * dEntropyRate;
     // zdot enters through the argument rates, whose zdot-rows equal the z-rows of the arguments
     K.row(localThermal_) += args.beta * response.theta * chain(entropy.grad, rows);
+  }
+}
+
+StagePath LumpedElement::stagePath(const StageArgs& args) const {
+  const CollocationRule& rule = *args.rule;
+  StagePath path;
+  path.column = args.column;
+  path.start = arguments(args.zOld);
+  path.end = arguments(args.zEnd);
+  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows);
+  for (int j = 0; j < rule.stages; ++j) {
+    const double* z = args.stageState[j];
+    const double* zdot = args.stageRate[j];
+    const Vec3 separation = geometry_ ? geometry_->separation(z) : Vec3::Zero();
+    const Vec3 separationRate = geometry_ ? geometry_->separationRate(zdot) : Vec3::Zero();
+    path.value[j] = arguments(z);
+    // tau-rates a' = dt (2 d . d', s', gamma')
+    path.rate[j] = args.dt * Vec3(2.0 * separation.dot(separationRate),
+                                  localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
+                                  localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
+    argumentRows(separation, path.rows[j]);
+    // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
+    // on its own stage's separation as well
+    const double rateCoefficient = rule.rate[j][args.column + 1];
+    for (int i = 0; i < 3; ++i) path.rateRows[j][i] = rateCoefficient * path.rows[j][i];
+    if (geometry_ && j == args.column) geometry_->addSeparationRow(path.rateRows[j][0], 2.0 * args.dt * separationRate);
+  }
+  return path;
+}
+
+void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
+  const int l = args.stage;
+  const StagePath path = stagePath(args);
+  auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
+  auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
+  const GradientRows dEnergy = consistentGradient(energy, mask_, spec_.argumentScale, *args.rule, path, l);
+  const GradientRows dEntropy = consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
+  const Response response = respond(dEnergy, dEntropy);
+
+  // rates at the stage: gamma' and the consistent entropy rate D eta . a' / dt, whose Gauss sum
+  // is the element's entropy change
+  const Vec3& rate = path.rate[l];
+  const double gammaRate = rate[2] / args.dt;
+  const double entropyRate = dEntropy.grad.dot(rate) / args.dt;
+  const Vec3 separation = geometry_ ? geometry_->separation(args.stageState[l]) : Vec3::Zero();
+  addBalances(response, 1.0, 2.0 * separation, gammaRate, entropyRate, ws, out, flows);
+
+  // explicit dependence: the force direction 2 d_l on its own stage, gamma' and the entropy rate
+  auto K = out.tangent();
+  if (geometry_ && l == args.column)
+    geometry_->addSeparationTangent(out, (2.0 * response.force) * Eigen::Matrix3d::Identity());
+  if (localInternal_ >= 0) K.row(localInternal_) += (response.viscosity / args.dt) * path.rateRows[l][2];
+  if (localThermal_ >= 0) {
+    LocalRow dEntropyRate = chain(dEntropy.grad, path.rateRows[l]);
+    for (int i = 0; i < 3; ++i) dEntropyRate += rate[i] * dEntropy.d[i];
+    K.row(localThermal_) += (response.theta / args.dt) * dEntropyRate;
   }
 }
 

@@ -7,7 +7,9 @@
 //   theta~ = D_s e / D_s eta,  f~ = D_c e - theta~ D_c eta,  g~ = -(D_gamma e - theta~ D_gamma eta)
 //   momentum:  f~ dc/dq(q_mid)          internal: nu (gamma' - gamma)/dt = g~
 //   thermal:   theta~ (eta' - eta)/dt = g~^2/nu + heat from links
-// with D the discrete gradient in an EEM step and the exact partials in the rate form.
+// with D the discrete gradient in an EEM step, the exact partials in the rate form and the
+// energy-consistent stage gradient in an eem4 step.
+#include "engine/core/stage_gradient.hpp"
 #include "models/lumped/element_laws.hpp"
 #include "models/lumped/two_point_geometry.hpp"
 
@@ -46,24 +48,31 @@ class LumpedElement final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  StageForm stageForm() const override { return StageForm::Own; }
+  void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
-  // Conjugate quantities and their derivatives with respect to the arguments (c, s, gamma).
+  // Conjugate quantities and their derivatives over the local dofs.
   struct Response {
     double force = 0.0, theta = 0.0, drivingForce = 0.0, viscosity = 1.0;
-    Vec3 dForce = Vec3::Zero(), dTheta = Vec3::Zero(), dDrivingForce = Vec3::Zero(), dViscosity = Vec3::Zero();
+    LocalRow dForce, dTheta, dDrivingForce, dViscosity;
   };
   static std::vector<int> collectDofs(const LumpedElementSpec& spec);
   Vec3 arguments(const double* z) const;
-  Response respond(const DiscreteGradient& dEnergy, const DiscreteGradient& dEntropy) const;
+  // From the (discrete) gradients of energy and entropy over (c, s, gamma).
+  Response respond(const GradientRows& dEnergy, const GradientRows& dEntropy) const;
   // Rows over local dofs of d(c, s, gamma)/dz, c's at separation d.
   void argumentRows(const Vec3& separation, LocalRow (&rows)[3]) const;
   static LocalRow chain(const Vec3& dArguments, const LocalRow (&rows)[3]);
-  // Residual rows shared by both forms and the tangent terms through the response's
+  // A discrete gradient's derivative with respect to b, carried onto the local dofs.
+  static GradientRows alongRows(const DiscreteGradient& gradient, const LocalRow (&rows)[3]);
+  // The arguments along an eem4 step's stage polynomial, for the tangent block args.column.
+  StagePath stagePath(const StageArgs& args) const;
+  // Residual rows shared by all forms and the tangent terms through the response's
   // derivatives (times zCoefficient): momentum f (2 d), internal nu gammaRate - g, thermal
   // theta entropyRate - g^2/nu; also publishes the node temperature.
-  void addBalances(const Response& response, const LocalRow (&rows)[3], double zCoefficient, const Vec3& forceDirection,
-                   double gammaRate, double entropyRate, Workspace& ws, LocalSystem& out, Flows& flows) const;
+  void addBalances(const Response& response, double zCoefficient, const Vec3& forceDirection, double gammaRate,
+                   double entropyRate, Workspace& ws, LocalSystem& out, Flows& flows) const;
 
   LumpedElementSpec spec_;
   std::optional<TwoPointGeometry> geometry_;

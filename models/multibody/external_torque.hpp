@@ -18,6 +18,8 @@ class ExternalTorque final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: no energy: its power is external work at each stage
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   // Residual -tau x d_i / 2 on the director momentum rows, the power with the director rates,

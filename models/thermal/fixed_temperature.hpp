@@ -13,6 +13,8 @@ class FixedTemperature final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: no energy: a temperature published at each stage
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   void publish(Workspace& ws) const;

@@ -26,6 +26,8 @@ class HeatLink final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: no energy: heat between the temperatures each stage publishes
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   // Residual -Q on both nodes' thermal rows and its tangent through the node temperatures.

@@ -1,0 +1,86 @@
+#pragma once
+// The energy-consistent gradient of a scalar function psi of up to three arguments along the
+// stage polynomial of an eem4 step (docs/theory.md section 12.2). At stage l it is
+//   D psi_l = grad psi(a_l) + mu G a'_l,
+//   mu = [psi(a_end) - psi(a_0) - sum_j b_j grad psi(a_j) . a'_j] / sum_j b_j a'_j . G a'_j,
+// with a'_j = da/dtau at stage j (tau = (t - t_n) / dt) and the diagonal metric G = 1/scale^2.
+// The Gauss sum of D psi . a' is then psi(a_end) - psi(a_0) (exactly but for a floor that only
+// acts where the arguments barely move, kStagePathFloor). The correction is the
+// quadrature error, O(dt^5) for two stages, divided by O(dt^2): it leaves the order 4 intact.
+#include "engine/core/collocation_rule.hpp"
+#include "engine/core/component.hpp"
+#include "engine/core/discrete_gradient.hpp"
+
+namespace mpx {
+
+// A gradient over the arguments and the derivative of each entry over a component's local dofs.
+struct GradientRows {
+  Vec3 grad = Vec3::Zero();
+  LocalRow d[3];
+};
+
+// The arguments of one component along the stage polynomial, for the tangent block of stage
+// `column`: at each stage j the arguments a_j, their tau-rates a'_j, the rows of da_j/dZ_j and
+// of da'_j/dZ_column over the local dofs; a_0 at the start and a_end with d a_end/dz_end.
+struct StagePath {
+  int column = 0;
+  Vec3 start = Vec3::Zero(), end = Vec3::Zero();
+  LocalRow endRows[3];
+  Vec3 value[CollocationRule::kMostStages], rate[CollocationRule::kMostStages];
+  LocalRow rows[CollocationRule::kMostStages][3], rateRows[CollocationRule::kMostStages][3];
+};
+
+// The floor of mu's denominator: N + k^2 / (N + k) for N = sum_j b_j a'_j . G a'_j. The defect
+// carries the round-off of psi(a_end) - psi(a_0), eps |psi|, which mu = defect / N would amplify
+// without bound where the arguments barely move; with the floor it reaches the residual as at
+// most eps / sqrt(k) (1e-11 relative) and the tangent as eps / k (1e-6). Where the arguments
+// move the floor is N (1 + (k / N)^2): the Gauss sum misses psi's change by (k / N)^2 of the
+// defect (itself the O(dt^5) quadrature error), 1e-4 of it even at relative argument changes
+// of 1e-5 per step.
+inline constexpr double kStagePathFloor = 1e-10;
+
+// D psi at stage `stage` and its derivative with respect to stage path.column's values; f maps
+// a Vec3 to a Jet, `mask` selects the active arguments.
+template <class Fn>
+GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, const CollocationRule& rule,
+                                const StagePath& path, int stage) {
+  const int n = static_cast<int>(path.endRows[0].size()), s = rule.stages, k = path.column;
+  Vec3 metric = Vec3::Zero();
+  for (int i = 0; i < 3; ++i)
+    if (mask >> i & 1u) metric[i] = 1.0 / (scale[i] * scale[i]);
+  auto alongRows = [&](const Vec3& coefficients, const LocalRow (&rows)[3]) -> LocalRow {
+    return coefficients[0] * rows[0] + coefficients[1] * rows[1] + coefficients[2] * rows[2];
+  };
+
+  Jet jet[CollocationRule::kMostStages];
+  const Jet endJet = f(path.end);
+  double defect = endJet.value - f(path.start).value, norm = 0.0;
+  for (int j = 0; j < s; ++j) {
+    jet[j] = f(path.value[j]);
+    defect -= rule.weight[j] * jet[j].grad.dot(path.rate[j]);
+    norm += rule.weight[j] * path.rate[j].dot(metric.cwiseProduct(path.rate[j]));
+  }
+  GradientRows out;
+  out.grad = jet[stage].grad;
+  for (int i = 0; i < 3; ++i)
+    out.d[i] = stage == k ? alongRows(jet[stage].hess.row(i).transpose(), path.rows[stage]) : LocalRow::Zero(n);
+  // mu and its derivative, from those of the defect and of the floored norm
+  const double floorRatio = kStagePathFloor / (norm + kStagePathFloor);
+  const double dFlooredDNorm = 1.0 - floorRatio * floorRatio;
+  norm += kStagePathFloor * floorRatio;
+  const double mu = defect / norm;
+  LocalRow dDefect = rule.end[k + 1] * alongRows(endJet.grad, path.endRows);
+  LocalRow dNorm = LocalRow::Zero(n);
+  for (int j = 0; j < s; ++j) {
+    if (j == k) dDefect -= rule.weight[j] * alongRows(jet[j].hess * path.rate[j], path.rows[j]);
+    dDefect -= rule.weight[j] * alongRows(jet[j].grad, path.rateRows[j]);
+    dNorm += (2.0 * rule.weight[j]) * alongRows(metric.cwiseProduct(path.rate[j]), path.rateRows[j]);
+  }
+  const LocalRow dMu = (dDefect - (mu * dFlooredDNorm) * dNorm) / norm;
+  const Vec3 direction = metric.cwiseProduct(path.rate[stage]);
+  out.grad += mu * direction;
+  for (int i = 0; i < 3; ++i) out.d[i] += direction[i] * dMu + (mu * metric[i]) * path.rateRows[stage][i];
+  return out;
+}
+
+}  // namespace mpx
