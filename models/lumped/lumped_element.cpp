@@ -203,7 +203,11 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
   const GradientRows dEnergy = consistentGradient(energy, mask_, spec_.argumentScale, *args.rule, path, l);
   const GradientRows dEntropy = consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
-  const Response response = respond(dEnergy, dEntropy);
+  Response response = respond(dEnergy, dEntropy);
+  // at steps far too long for the motion the stage temperature can leave (0, inf): that is no
+  // solution (its heat would lower the entropy), so the residual is made non-finite and Newton
+  // backtracks or the step is cut back
+  if ((mask_ & kThermalBit) && !(response.theta > 0.0)) response.theta = NAN;
 
   // rates at the stage: gamma' and the consistent entropy rate D eta . a' / dt, whose Gauss sum
   // is the element's entropy change
