@@ -1,5 +1,5 @@
 // The fourth-order EEM step (eem4: energy-consistent two-stage Gauss collocation, docs/theory.md
-// section 12): observed order 4 against a fine run, the energy balance and entropy production at
+// section 13): observed order 4 against a fine run, the energy balance and entropy production at
 // every step also at large steps, exact momenta, the stability of a stiff linear dissipative
 // mode, and the scenes it refuses.
 #include "support.hpp"
@@ -67,7 +67,7 @@ class Eem4Balances : public ::testing::TestWithParam<BalanceCase> {};
 // element turns at an almost constant length (the Maxwell elements once their oscillation has
 // died out) the stage gradients' correction is a ratio of two small quantities, Newton stops
 // nearer its tolerance, and the balance closes to 1e-9 rather than to round-off
-// (docs/theory.md section 12.4).
+// (docs/theory.md section 13.4).
 TEST_P(Eem4Balances, HoldAtEveryStep) {
   const BalanceCase c = GetParam();
   const CompiledScene scene = loadScene(scenePath(c.scene));
@@ -76,15 +76,13 @@ TEST_P(Eem4Balances, HoldAtEveryStep) {
   const double scale = largestEnergy(h);
   double worstStep = 0.0, leastProduction = INFINITY;
   for (std::size_t n = 1; n < h.energy.size(); ++n) {
-    auto balance = [&](std::size_t k) {
-      return h.energy[k] + h.dissipated[k] - h.externalWork[k] - h.boundaryHeat[k];
-    };
+    auto balance = [&](std::size_t k) { return h.energy[k] + h.dissipated[k] - h.externalWork[k] - h.boundaryHeat[k]; };
     worstStep = std::max(worstStep, std::abs(balance(n) - balance(n - 1)) / scale);
     const double production = h.entropy[n] - h.entropy[n - 1] - (h.boundaryEntropy[n] - h.boundaryEntropy[n - 1]);
     leastProduction = std::min(leastProduction, production / std::max(1.0, std::abs(h.entropy[n])));
   }
-  std::printf("eem4 on %s at dt %g: worst step balance %.2e, least entropy production %.2e\n", c.scene, c.dt,
-              worstStep, leastProduction);
+  std::printf("eem4 on %s at dt %g: worst step balance %.2e, least entropy production %.2e\n", c.scene, c.dt, worstStep,
+              leastProduction);
   EXPECT_LT(worstStep, c.balanceTolerance);
   EXPECT_GT(leastProduction, -c.productionTolerance);
 }

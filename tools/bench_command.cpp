@@ -245,6 +245,14 @@ int benchCommand(const BenchRequest& request) {
       fmt::print("ida left out: {}\n", idaRefusal);
       continue;
     }
+    if (method->scheme == Scheme::Eem4) {
+      try {
+        checkMethodSupports(*method, *own.model, request.scene);
+      } catch (const InputError& refusal) {
+        fmt::print("{} left out: {}\n", method->name, refusal.what());
+        continue;
+      }
+    }
     methods.push_back(*method);
   }
   if (methods.empty()) throw InputError("option --integrators: nothing to run on this scene: " + idaRefusal);

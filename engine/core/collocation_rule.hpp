@@ -1,5 +1,5 @@
 #pragma once
-// Gauss collocation in time (the eem4 step, docs/theory.md section 12): the state is a
+// Gauss collocation in time (the eem4 step, docs/theory.md section 13): the state is a
 // polynomial of degree s over the step through z(t) and the stage values Z_1..Z_s at the
 // Gauss-Legendre nodes t + c_l dt, and the rate form holds at each node. It is the continuous
 // Galerkin time finite element cG(s) with s-point Gauss quadrature, of order 2s.

@@ -145,8 +145,7 @@ class Component {
   // an energy-consistent form of its own (Own: stageLocal). None: eem4 refuses the scene.
   enum class StageForm { None, RateAtStages, Own };
   virtual StageForm stageForm() const { return StageForm::None; }
-  virtual void stageLocal(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem& /*out*/,
-                          Flows& /*flows*/) const {}
+  virtual void stageLocal(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem& /*out*/, Flows& /*flows*/) const {}
 
  protected:
   Component(std::string name, std::vector<int> dofs) : name_(std::move(name)), dofs_(std::move(dofs)) {}

@@ -1,6 +1,6 @@
 #pragma once
 // The energy-consistent gradient of a scalar function psi of up to three arguments along the
-// stage polynomial of an eem4 step (docs/theory.md section 12.2). At stage l it is
+// stage polynomial of an eem4 step (docs/theory.md section 13.2). At stage l it is
 //   D psi_l = grad psi(a_l) + mu G a'_l,
 //   mu = [psi(a_end) - psi(a_0) - sum_j b_j grad psi(a_j) . a'_j] / sum_j b_j a'_j . G a'_j,
 // with a'_j = da/dtau at stage j (tau = (t - t_n) / dt) and the diagonal metric G = 1/scale^2.
@@ -48,7 +48,7 @@ GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, c
   Vec3 metric = Vec3::Zero();
   for (int i = 0; i < 3; ++i)
     if (mask >> i & 1u) metric[i] = 1.0 / (scale[i] * scale[i]);
-  auto alongRows = [&](const Vec3& coefficients, const LocalRow (&rows)[3]) -> LocalRow {
+  auto alongRows = [&](const Vec3& coefficients, const LocalRow(&rows)[3]) -> LocalRow {
     return coefficients[0] * rows[0] + coefficients[1] * rows[1] + coefficients[2] * rows[2];
   };
 

@@ -28,7 +28,8 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
   const int n = model.layout().total(), withScale = model.layout().offset(Block::Multiplier);
   unknownScale_ = model.dofScale().replicate(rule_.stages, 1);
   incrementScale_ = unknownScale_;
-  for (int l = 0; l < rule_.stages; ++l) incrementScale_.segment(l * n + withScale, n - withScale).setConstant(INFINITY);
+  for (int l = 0; l < rule_.stages; ++l)
+    incrementScale_.segment(l * n + withScale, n - withScale).setConstant(INFINITY);
   if (scheme == Scheme::Eem4) {
     stages_.resize(rule_.stages * n);
     stageRates_.resize(rule_.stages * n);

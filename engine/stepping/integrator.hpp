@@ -18,7 +18,7 @@
 namespace mpx {
 
 // Eem4: two-stage Gauss collocation with energy-consistent stage gradients (docs/theory.md
-// section 12), whose Newton unknowns are the values at both stages.
+// section 13), whose Newton unknowns are the values at both stages.
 enum class Scheme { Eem, Eem4, Midpoint, Trapezoidal };
 
 // The order of a scheme's local truncation error minus one (its global order).
@@ -88,8 +88,7 @@ class Integrator {
                     StepOutcome& outcome);
   // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess).
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
-  bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns,
-                     StepOutcome& outcome);
+  bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
   // eem4: the stage rates and the end state of the stage polynomial, then its residual.
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt);
   // z(t + dt) of the stage polynomial.
@@ -112,7 +111,7 @@ class Integrator {
   // have no natural scale; their rows' residual, the constraints, judges them)
   Eigen::VectorXd unknownScale_, incrementScale_;
   Eigen::VectorXd stages_, stageRates_, stageEnd_;  // eem4
-  std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
+  std::vector<Eigen::VectorXd> halfState_;          // one midpoint state per cut-back level
   // simplified Newton: the step size the factorisation belongs to (0: none held)
   double factorizedDt_ = 0.0;
   // predictor: the last accepted step, lastStart_ at lastTime_ to lastEnd_ over lastDt_

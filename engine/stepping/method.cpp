@@ -26,6 +26,8 @@ std::optional<Method> methodByName(const std::string& name) {
   const bool adaptive =
       name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
   std::optional<Method> method = fixedStepMethod(adaptive ? name.substr(0, name.size() - suffix.size()) : name);
+  // eem4 has no error estimate of its order yet: fixed steps only
+  if (method && adaptive && method->scheme == Scheme::Eem4) return std::nullopt;
   if (method) method->name = name, method->adaptive = adaptive;
   return method;
 }
@@ -37,7 +39,7 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
         throw InputError(scene + ": integrator '" + method.name + "' has no fourth-order form for element '" +
                          component->name() +
                          "' yet (eem4 covers masses, springs, thermo-springs, Maxwell elements, dampers, heat links, "
-                         "reservoirs, fixed temperatures, forces and actuators; docs/theory.md section 12)");
+                         "reservoirs, fixed temperatures, forces and actuators; docs/theory.md section 13)");
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.kind == PrescribedKind::Displacement)

@@ -99,8 +99,8 @@ void LumpedElement::addBalances(const Response& response, double zCoefficient, c
     // the viscous power heats the element's own node
     const double heating = localInternal_ >= 0 ? g * g / nu : 0.0;
     r[localThermal_] += response.theta * entropyRate - heating;
-    K.row(localThermal_) +=
-        zCoefficient * (entropyRate * response.dTheta - (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
+    K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta -
+                                            (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
     NodeTemperature& node = ws.nodes[spec_.thermalNode];
     node.value = response.theta;
     node.count = out.n;
@@ -183,9 +183,9 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
     const Vec3 separationRate = geometry_ ? geometry_->separationRate(zdot) : Vec3::Zero();
     path.value[j] = arguments(z);
     // tau-rates a' = dt (2 d . d', s', gamma')
-    path.rate[j] = args.dt * Vec3(2.0 * separation.dot(separationRate),
-                                  localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
-                                  localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
+    path.rate[j] =
+        args.dt * Vec3(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
+                       localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
     argumentRows(separation, path.rows[j]);
     // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
     // on its own stage's separation as well
