@@ -228,6 +228,8 @@ const SchemeChoice kEemEntropy{"eem-entropy", Scheme::Eem, ThermalVariable::Entr
 const SchemeChoice kEemTemperature{"eem-temperature", Scheme::Eem, ThermalVariable::Temperature};
 const SchemeChoice kMidpoint{"midpoint", Scheme::Midpoint, std::nullopt};
 const SchemeChoice kTrapezoidal{"trapezoidal", Scheme::Trapezoidal, std::nullopt};
+const SchemeChoice kEem4Entropy{"eem4-entropy", Scheme::Eem4, ThermalVariable::Entropy};
+const SchemeChoice kEem4Temperature{"eem4-temperature", Scheme::Eem4, ThermalVariable::Temperature};
 
 // Compile the scene once per case (outside any timing) and register its step benchmark.
 void registerCases(const std::string& sceneName, const SceneSource& source,
@@ -353,11 +355,11 @@ int main(int argc, char** argv) {
 
   // every case is registered; --benchmark_filter picks which run
   registerCases("two_thermo_springs", sceneFile("two_thermo_springs.xml"),
-                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
+                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal, kEem4Entropy, kEem4Temperature});
   registerCases("thermo_visco_elastic", sceneFile("thermo_visco_elastic.xml"),
-                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal});
+                {kEemEntropy, kEemTemperature, kMidpoint, kTrapezoidal, kEem4Entropy, kEem4Temperature});
   registerCases("thermo_spring_chain_1000", sceneSpec(thermoSpringChain(1000, 0.05)),
-                {kEemEntropy, kEemTemperature, kMidpoint});
+                {kEemEntropy, kEemTemperature, kMidpoint, kEem4Entropy});
   // rigid multibody: a long open chain under both enforcements, and a spatial closed loop
   registerCases("rigid_chain_50", sceneSpec(rigidChain(50, Enforcement::AugmentedLagrangian, 1e4, 1e-3)), {kEem});
   registerCases("rigid_chain_50_penalty", sceneSpec(rigidChain(50, Enforcement::Penalty, 1e8, 1e-3)), {kEem});

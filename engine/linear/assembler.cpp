@@ -17,7 +17,16 @@ Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(mo
   residual_ = Eigen::VectorXd::Zero(unknowns);
   rowScale_ = Eigen::VectorXd::Zero(unknowns);
 
-  // pattern: the coupled pairs of each component's dofs, plus the diagonal, in every block
+  // pattern: the coupled pairs of each component's dofs, plus the diagonal, in every block;
+  // a kinematic row (of a position) depends on velocities and not on their rates, so that off
+  // its own stage's block (where only rates couple stages) it has no velocity entries, and
+  // the stage system condenses as the one-stage system does
+  const Layout& layout = model.layout();
+  auto inBlock = [&](const Component& component, int rowStage, int columnStage, int i, int j) {
+    const int row = component.dofs()[i], column = component.dofs()[j];
+    return component.couples(i, j) && (rowStage == columnStage || layout.blockOf(row) != Block::Position ||
+                                       layout.blockOf(column) != Block::Velocity);
+  };
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < unknowns; ++i) entries.emplace_back(i, i, 0.0);
   for (const auto& component : model.components()) {
@@ -26,9 +35,9 @@ Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(mo
       throw std::logic_error("component '" + component->name() + "' touches more than kMaxLocalDofs dofs");
     for (int rowStage = 0; rowStage < stages; ++rowStage)
       for (int columnStage = 0; columnStage < stages; ++columnStage)
-        for (std::size_t i = 0; i < dofs.size(); ++i)
-          for (std::size_t j = 0; j < dofs.size(); ++j)
-            if (component->couples(static_cast<int>(i), static_cast<int>(j)))
+        for (int i = 0; i < static_cast<int>(dofs.size()); ++i)
+          for (int j = 0; j < static_cast<int>(dofs.size()); ++j)
+            if (inBlock(*component, rowStage, columnStage, i, j))
               entries.emplace_back(dofs[i] + rowStage * n, dofs[j] + columnStage * n, 0.0);
   }
   tangent_.resize(unknowns, unknowns);
@@ -41,9 +50,9 @@ Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(mo
     for (int rowStage = 0; rowStage < stages; ++rowStage)
       for (int columnStage = 0; columnStage < stages; ++columnStage) {
         std::vector<std::pair<int, int>> map;
-        for (std::size_t j = 0; j < dofs.size(); ++j)
-          for (std::size_t i = 0; i < dofs.size(); ++i) {
-            if (!component->couples(static_cast<int>(i), static_cast<int>(j))) continue;
+        for (int j = 0; j < static_cast<int>(dofs.size()); ++j)
+          for (int i = 0; i < static_cast<int>(dofs.size()); ++i) {
+            if (!inBlock(*component, rowStage, columnStage, i, j)) continue;
             map.emplace_back(static_cast<int>(i + j * dofs.size()),
                              findEntry(tangent_, dofs[i] + rowStage * n, dofs[j] + columnStage * n));
           }

@@ -9,28 +9,53 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 }  // namespace
 
 CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : pattern_(&pattern) {
-  // positions come first in the layout, velocities right after, dof for dof; the system of
-  // several stages (eem4) is solved whole
-  const bool oneStage = pattern.rows() == layout.total();
-  if (!oneStage) wholeSystemReason_ = "it is the stage system of a collocation step";
-  const bool paired = oneStage && layout.has(Block::Position) &&
-                      layout.size(Block::Position) == layout.size(Block::Velocity) &&
+  // positions come first in the layout, velocities right after, dof for dof; a collocation
+  // step's system (eem4) repeats the layout once per stage, and each stage's kinematic rows
+  // pair with its own velocities in the same way
+  const int n = layout.total(), stages = static_cast<int>(pattern.rows()) / n;
+  const bool paired = layout.has(Block::Position) && layout.size(Block::Position) == layout.size(Block::Velocity) &&
                       layout.offset(Block::Position) == 0;
-  velocities_ = paired ? layout.size(Block::Velocity) : 0;
-  if (velocities_ > 0 && !buildCondensation(pattern)) velocities_ = 0;
+  if (paired) {
+    numberUnknowns(n, layout.size(Block::Position), stages);
+    if (!buildCondensation(pattern)) velocities_ = 0;
+  }
   reducedRhs_.resize(pattern.rows() - velocities_);
-  // internal variables, numbered as in the velocity-condensed system
+  // internal variables, numbered as in the velocity-condensed system (one-stage systems only)
   const SparseMatrix& stage = velocities_ > 0 ? reduced_ : pattern;
-  internal_.build(stage, layout.offset(Block::Internal) - velocities_, oneStage ? layout.size(Block::Internal) : 0);
+  const int velocitiesBefore = velocities_ > 0 ? layout.size(Block::Velocity) : 0;
+  internal_.build(stage, layout.offset(Block::Internal) - velocitiesBefore, stages == 1 ? layout.size(Block::Internal) : 0);
   internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
   internalSolution_.resize(stage.rows());
   lu_ = makeSparseLu(static_cast<int>(factorised().rows()));
 }
 
+void CondensedSolver::numberUnknowns(int n, int positions, int stages) {
+  // unknown u = stage n + i; the kinematic row of position i pairs with velocity u + positions
+  stateSize_ = n;
+  velocities_ = stages * positions;
+  velocityOffset_ = positions;
+  kinematicRow_.resize(velocities_);
+  kinematicIndex_.assign(stages * n, -1);
+  reducedIndex_.assign(stages * n, -1);
+  for (int stage = 0; stage < stages; ++stage)
+    for (int i = 0; i < n; ++i) {
+      const int u = stage * n + i, kept = stage * (n - positions);
+      // a position keeps its column, the momentum row of its velocity takes its row's place
+      reducedIndex_[u] = kept + (i < positions ? i : i - positions);
+      if (i < positions) {
+        kinematicRow_[stage * positions + i] = u;
+        kinematicIndex_[u] = stage * positions + i;
+      }
+    }
+}
+
+std::string CondensedSolver::dofName(int unknown) const {
+  const std::string dof = "dof " + std::to_string(unknown % stateSize_);
+  return unknown < stateSize_ ? dof : dof + " of stage " + std::to_string(unknown / stateSize_ + 1);
+}
+
 bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   const int n = static_cast<int>(pattern.rows()), nv = velocities_;
-  auto isPosition = [&](int dof) { return dof < nv; };
-  auto isVelocity = [&](int dof) { return dof >= nv && dof < 2 * nv; };
 
   // kinematic rows: their entries in kept columns (by row, and by column for the condensation),
   // and the single velocity entry d_i
@@ -41,17 +66,17 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   for (int column = 0; column < n; ++column) {
     kinematicColumnStart_[column] = static_cast<int>(kinematicColumns_.size());
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
-      const int row = static_cast<int>(it.row());
-      if (!isPosition(row)) continue;
+      const int row = static_cast<int>(it.row()), k = kinematicIndex_[row];
+      if (k < 0) continue;
       const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
       if (!isVelocity(column)) {
-        kinematicRows_[row].push_back({column, entry});
-        kinematicColumns_.push_back({row, entry});
-      } else if (column - nv == row)
-        pivotEntry_[row] = entry;
+        kinematicRows_[k].push_back({column, entry});
+        kinematicColumns_.push_back({k, entry});
+      } else if (column == velocityOf(k))
+        pivotEntry_[k] = entry;
       else {
-        wholeSystemReason_ = "the kinematic row of position dof " + std::to_string(row) + " couples to velocity dof " +
-                             std::to_string(column) + " (a component declares that it writes position rows)";
+        wholeSystemReason_ = "the kinematic row of position " + dofName(row) + " couples to velocity " +
+                             dofName(column) + " (a component declares that it writes position rows)";
         return false;
       }
     }
@@ -59,7 +84,7 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   kinematicColumnStart_[n] = static_cast<int>(kinematicColumns_.size());
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
     wholeSystemReason_ =
-        "position dof " + std::to_string(missing - pivotEntry_.begin()) + " has no kinematic row (no inertia owns it)";
+        "position " + dofName(kinematicRow_[missing - pivotEntry_.begin()]) + " has no kinematic row (no inertia owns it)";
     return false;
   }
 
@@ -69,18 +94,18 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   std::vector<int> rows;
   std::vector<char> seen(n - nv, 0);
   auto mark = [&](int row) {
-    if (row < nv || seen[reducedRow(row)]) return;
-    seen[reducedRow(row)] = 1;
-    rows.push_back(reducedRow(row));
+    if (isPosition(row) || seen[reducedIndex_[row]]) return;
+    seen[reducedIndex_[row]] = 1;
+    rows.push_back(reducedIndex_[row]);
   };
   for (int column = 0; column < n; ++column) {
     if (isVelocity(column)) continue;
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) mark(static_cast<int>(it.row()));
     for (int k = kinematicColumnStart_[column]; k < kinematicColumnStart_[column + 1]; ++k)
-      for (SparseMatrix::InnerIterator it(pattern, nv + kinematicColumns_[k].position); it; ++it)
+      for (SparseMatrix::InnerIterator it(pattern, velocityOf(kinematicColumns_[k].position)); it; ++it)
         mark(static_cast<int>(it.row()));
     for (const int row : rows) {
-      entries.emplace_back(row, reducedColumn(column), 0.0);
+      entries.emplace_back(row, reducedIndex_[column], 0.0);
       seen[row] = 0;
     }
     rows.clear();
@@ -101,22 +126,21 @@ bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
 
 void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
   const double* k = tangent.valuePtr();
-  const int n = static_cast<int>(tangent.rows()), nv = velocities_;
+  const int n = static_cast<int>(tangent.rows());
   double* reduced = reduced_.valuePtr();
   // each condensed column in a dense work column: K(j, c), minus the products in the order of
   // i, then copied into the condensed values (the work column is zero again afterwards)
   for (int column = 0; column < n; ++column) {
-    if (column >= nv && column < 2 * nv) continue;
+    if (isVelocity(column)) continue;
     for (SparseMatrix::InnerIterator it(tangent, column); it; ++it)
-      if (it.row() >= nv) condensedColumn_[reducedRow(static_cast<int>(it.row()))] += it.value();
+      if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] += it.value();
     for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
       const auto [i, kinematicEntry] = kinematicColumns_[term];
-      for (SparseMatrix::InnerIterator it(tangent, nv + i); it; ++it)
-        if (it.row() >= nv)
-          condensedColumn_[reducedRow(static_cast<int>(it.row()))] -=
-              it.value() * k[kinematicEntry] / k[pivotEntry_[i]];
+      for (SparseMatrix::InnerIterator it(tangent, velocityOf(i)); it; ++it)
+        if (!isPosition(static_cast<int>(it.row())))
+          condensedColumn_[reducedIndex_[it.row()]] -= it.value() * k[kinematicEntry] / k[pivotEntry_[i]];
     }
-    const int target = reducedColumn(column);
+    const int target = reducedIndex_[column];
     for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e) {
       double& value = condensedColumn_[reduced_.innerIndexPtr()[e]];
       reduced[e] = value;
@@ -147,21 +171,22 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
   const int n = static_cast<int>(K.rows()), nv = velocities_;
 
   // right-hand side: -r_j + sum_i K(j, v_i) r_qi / d_i over the kept rows j
-  reducedRhs_ = -residual.tail(n - nv);
+  for (int row = 0; row < n; ++row)
+    if (!isPosition(row)) reducedRhs_[reducedIndex_[row]] = -residual[row];
   for (int i = 0; i < nv; ++i) {
-    const double factor = residual[i] / k[pivotEntry_[i]];
-    for (SparseMatrix::InnerIterator it(K, nv + i); it; ++it)
-      if (it.row() >= nv) reducedRhs_[reducedRow(static_cast<int>(it.row()))] += it.value() * factor;
+    const double factor = residual[kinematicRow_[i]] / k[pivotEntry_[i]];
+    for (SparseMatrix::InnerIterator it(K, velocityOf(i)); it; ++it)
+      if (!isPosition(static_cast<int>(it.row()))) reducedRhs_[reducedIndex_[it.row()]] += it.value() * factor;
   }
   solveVelocityCondensed(reducedRhs_);
 
   // kept unknowns, then the velocities from their kinematic rows
-  increment.head(nv) = reducedRhs_.head(nv);
-  increment.tail(n - 2 * nv) = reducedRhs_.tail(n - 2 * nv);
+  for (int column = 0; column < n; ++column)
+    if (!isVelocity(column)) increment[column] = reducedRhs_[reducedIndex_[column]];
   for (int i = 0; i < nv; ++i) {
-    double sum = residual[i];
+    double sum = residual[kinematicRow_[i]];
     for (const RowEntry& kinematic : kinematicRows_[i]) sum += k[kinematic.entry] * increment[kinematic.column];
-    increment[nv + i] = -sum / k[pivotEntry_[i]];
+    increment[velocityOf(i)] = -sum / k[pivotEntry_[i]];
   }
 }
 

@@ -6,7 +6,8 @@
 // and substituting it leaves a system in positions, thermal, internal and multiplier
 // unknowns only, with the momentum rows in place of the kinematic ones: half the size for
 // mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
-// Scenes whose pattern does not have this structure are solved whole. Internal variables that
+// A collocation step's system (eem4: the layout once per stage) is condensed stage by stage
+// in the same way. Scenes whose pattern does not have this structure are solved whole. Internal variables that
 // split into small independent groups (per quadrature point, per Maxwell element) are then
 // eliminated as well (engine/linear/group_elimination), so that what is factorised is the system of
 // positions, thermal unknowns and multipliers.
@@ -44,28 +45,42 @@ class CondensedSolver {
   std::string describe() const;
 
  private:
-  // An entry of a kinematic row q_i off its velocity: column c (a kept dof) and its place in K.
+  // An entry of kinematic row i off its velocity: column c (a kept dof) and its place in K.
   struct RowEntry {
     int column, entry;
   };
-  // The same entry seen from its column: the position dof q_i of its row and its place in K.
+  // The same entry seen from its column: the kinematic row i and its place in K.
   struct ColumnEntry {
     int position, entry;
   };
+  // The maps below for `stages` copies of a layout of n dofs with `positions` positions.
+  void numberUnknowns(int n, int positions, int stages);
   bool buildCondensation(const Eigen::SparseMatrix<double>& pattern);
+  // "dof i", or "dof i of stage l" in a collocation step's system, for messages
+  std::string dofName(int unknown) const;
   void condenseVelocities(const Eigen::SparseMatrix<double>& tangent);
   // Solve the velocity-condensed system in place, through the internal elimination if any.
   void solveVelocityCondensed(Eigen::VectorXd& rhs);
-  // Index of a kept row / column in the condensed system (velocity row v_i takes q_i's place).
-  int reducedRow(int row) const { return row - velocities_; }
-  int reducedColumn(int column) const { return column < velocities_ ? column : column - velocities_; }
+  bool isPosition(int unknown) const { return kinematicIndex_[unknown] >= 0; }
+  bool isVelocity(int unknown) const {
+    // velocity i of a stage sits `positions` after position i; no other unknown does (n >= 2 positions)
+    return unknown >= velocityOffset_ && isPosition(unknown - velocityOffset_);
+  }
+  // the velocity unknown of kinematic row i
+  int velocityOf(int i) const { return kinematicRow_[i] + velocityOffset_; }
   // The matrix after velocity condensation (the tangent itself without it).
   const Eigen::SparseMatrix<double>& velocityCondensed() const { return velocities_ > 0 ? reduced_ : *tangent_; }
   const Eigen::SparseMatrix<double>& factorised() const {
     return internal_.active() ? internal_.reduced() : velocities_ > 0 ? reduced_ : *pattern_;
   }
 
-  int velocities_ = 0;  // 0: solved whole
+  int velocities_ = 0;      // velocity unknowns eliminated, all stages (0: solved whole)
+  int velocityOffset_ = 0;  // from a position unknown to its velocity
+  int stateSize_ = 0;       // of one stage
+  // per kinematic row i (all stages): its position unknown; per unknown: its kinematic row
+  // (-1 if not a position), and its index in the condensed system as a kept row or column
+  // (a velocity's momentum row takes its position's place)
+  std::vector<int> kinematicRow_, kinematicIndex_, reducedIndex_;
   std::string wholeSystemReason_;
   const Eigen::SparseMatrix<double>* pattern_;
   const Eigen::SparseMatrix<double>* tangent_ = nullptr;
