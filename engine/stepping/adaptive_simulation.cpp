@@ -11,18 +11,13 @@ namespace mpx {
 namespace {
 
 // Step-size control of the usual kind (Hairer, Norsett & Wanner I, II.4): the next step is
-// dt (safety / err)^(1/3) for a local error of order 3, limited per step.
+// dt (safety / err)^(1/(p + 1)) for a scheme of order p, limited per step.
 constexpr double kSafety = 0.9;
 constexpr double kLargestGrowth = 2.0;
 constexpr double kLargestShrink = 0.2;
 constexpr double kShrinkAfterNewtonFailure = 0.25;
 // A step below this fraction of t_end ends the run as a failure.
 constexpr double kSmallestStepFraction = 1e-12;
-
-double stepFactor(double error) {
-  if (!(error > 0.0)) return kLargestGrowth;
-  return std::clamp(kSafety * std::cbrt(1.0 / error), kLargestShrink, kLargestGrowth);
-}
 
 // The dofs whose error is tested: positions, thermal and internal variables. Multipliers are
 // left out, as IDA leaves out algebraic variables. So are velocities: each step's mean velocity
@@ -37,17 +32,29 @@ std::vector<int> testedDofs(const Layout& layout) {
   return dofs;
 }
 
-// The local error of a step of a second-order one-step scheme, dt^3 |z'''| / 12 (the
-// trapezoidal rule's exactly, the midpoint rule's for linear systems), with z''' = 6 z[t0..t3]
-// from the last three accepted states of the current smooth stretch and the new one, in IDA's
-// weighted RMS norm over the tested dofs.
+// The local error of a step of a one-step scheme of order p, C dt^(p+1) |z^(p+1)|, with
+// z^(p+1) = (p+1)! z[t0..t(p+1)] from the last p + 1 accepted states of the current smooth
+// stretch and the new one, in IDA's weighted RMS norm over the tested dofs. C is the error
+// constant of the schemes on z' = lambda z: 1/12 for the second-order ones (the trapezoidal
+// rule's exactly, the midpoint rule's for linear systems), 1/720 for two-stage Gauss (eem4).
 class LocalError {
  public:
-  LocalError(const Model& model, const StepControl& control)
-      : rtol_(control.relativeTolerance),
+  LocalError(const Model& model, const StepControl& control, int order)
+      : order_(order),
+        history_(order + 1),
+        constant_(order == 4 ? 1.0 / 720.0 : 1.0 / 12.0),
+        rtol_(control.relativeTolerance),
         atolScale_(control.absoluteTolerance * model.dofScale()),
         tested_(testedDofs(model.layout())) {
     for (Eigen::VectorXd& state : states_) state.resize(model.layout().total());
+  }
+
+  // The step factor for an error norm: (safety / err)^(1/(p + 1)), unlimited.
+  double allowedFactor(double error) const {
+    return error > 0.0 ? kSafety * std::pow(error, -1.0 / (order_ + 1)) : INFINITY;
+  }
+  double stepFactor(double error) const {
+    return std::clamp(allowedFactor(error), kLargestShrink, kLargestGrowth);
   }
 
   // Start a new smooth stretch at (t, z): the loads have a kink here, or the run starts.
@@ -56,11 +63,11 @@ class LocalError {
     accept(t, z);
   }
   void accept(double t, const Eigen::VectorXd& z) {
-    std::rotate(times_.begin(), times_.begin() + 1, times_.end());
-    std::rotate(states_.begin(), states_.begin() + 1, states_.end());
-    times_.back() = t;
-    states_.back() = z;
-    count_ = std::min(count_ + 1, kHistory);
+    std::rotate(times_.begin(), times_.begin() + 1, times_.begin() + history_);
+    std::rotate(states_.begin(), states_.begin() + 1, states_.begin() + history_);
+    times_[history_ - 1] = t;
+    states_[history_ - 1] = z;
+    count_ = std::min(count_ + 1, history_);
   }
   void save(LoopState& out) const {
     out.errorHistoryCount = count_;
@@ -71,45 +78,56 @@ class LocalError {
     count_ = saved.errorHistoryCount;
     times_ = saved.errorTimes;
     states_ = saved.errorStates;
+    for (Eigen::VectorXd& state : states_) state.resize(atolScale_.size());
   }
-  // True when three states of this stretch are known, so that ofStep applies.
-  bool hasHistory() const { return count_ == kHistory; }
+  // True when p + 1 states of this stretch are known, so that ofStep applies.
+  bool hasHistory() const { return count_ == history_; }
 
-  // The error norm of the step from the last accepted state to (t, z).
+  // The error norm of the step from the last accepted state to (t, z): the divided
+  // differences of each tested dof over the history and the new point, built in place.
   double ofStep(double t, const Eigen::VectorXd& z) const {
-    const auto& [t0, t1, t2] = times_;
-    const Eigen::VectorXd &z0 = states_[0], &z1 = states_[1], &z2 = states_[2];
-    const double dt = t - t2;
+    std::array<double, LoopState::kMostErrorHistory + 1> time{}, difference{};
+    std::copy_n(times_.begin(), history_, time.begin());
+    time[history_] = t;
+    const double dt = t - times_[history_ - 1];
+    double factorial = 1.0;
+    for (int k = 2; k <= order_ + 1; ++k) factorial *= k;
+    const double scale = constant_ * factorial * std::pow(dt, order_ + 1);
     double sum = 0.0;
     for (int i : tested_) {
-      const double d01 = (z1[i] - z0[i]) / (t1 - t0), d12 = (z2[i] - z1[i]) / (t2 - t1), d23 = (z[i] - z2[i]) / dt;
-      const double d0123 = ((d23 - d12) / (t - t1) - (d12 - d01) / (t2 - t0)) / (t - t0);
-      sum += weighted(0.5 * dt * dt * dt * d0123, i);
+      for (int k = 0; k < history_; ++k) difference[k] = states_[k][i];
+      difference[history_] = z[i];
+      for (int level = 1; level <= history_; ++level)
+        for (int k = history_; k >= level; --k)
+          difference[k] = (difference[k] - difference[k - 1]) / (time[k] - time[k - level]);
+      sum += weighted(scale * difference[history_], i);
     }
     return rms(sum);
   }
   // The error norm of two half steps that reached `halves` against one full step to `full`:
-  // their difference is 3/4 of the full step's error, three times the halves'.
+  // their difference is (1 - 2^-p) of the full step's error, 2^p - 1 times the halves'.
   double ofHalving(const Eigen::VectorXd& halves, const Eigen::VectorXd& full) const {
+    const double times = std::ldexp(1.0, order_) - 1.0;
     double sum = 0.0;
-    for (int i : tested_) sum += weighted((halves[i] - full[i]) / 3.0, i);
+    for (int i : tested_) sum += weighted((halves[i] - full[i]) / times, i);
     return rms(sum);
   }
 
  private:
-  static constexpr int kHistory = 3;
   // (error_i / (rtol |z_i| + atol scale_i))^2 at the start of the step
   double weighted(double error, int i) const {
-    const double e = error / (rtol_ * std::abs(states_.back()[i]) + atolScale_[i]);
+    const double e = error / (rtol_ * std::abs(states_[history_ - 1][i]) + atolScale_[i]);
     return e * e;
   }
   double rms(double sum) const { return tested_.empty() ? 0.0 : std::sqrt(sum / tested_.size()); }
 
+  int order_, history_;
+  double constant_;
   double rtol_;
   Eigen::VectorXd atolScale_;
   std::vector<int> tested_;  // the dofs in the error test
-  std::array<double, kHistory> times_{};
-  std::array<Eigen::VectorXd, kHistory> states_;
+  std::array<double, LoopState::kMostErrorHistory> times_{};
+  std::array<Eigen::VectorXd, LoopState::kMostErrorHistory> states_;
   int count_ = 0;
 };
 
@@ -150,7 +168,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   summary.linearSystem = integrator.linearSolver().describe();
   const Checkpointing& checkpoints = options.checkpoints;
   RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
-  LocalError localError(model, control);
+  LocalError localError(model, control, schemeOrder(options.scheme));
   const Landings landings(model.loadBreakpoints(), control.outputInterval, options.tEnd);
   const int n = model.layout().total();
   Eigen::VectorXd next(n), half(n), fullStep(n);
@@ -214,7 +232,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
 
     if (!(error <= 1.0)) {
       ++summary.rejectedSteps;
-      proposed = dt * (std::isfinite(error) ? stepFactor(error) : kShrinkAfterNewtonFailure);
+      proposed = dt * (std::isfinite(error) ? localError.stepFactor(error) : kShrinkAfterNewtonFailure);
       if (proposed >= smallest) continue;
       summary.failed = true;
       summary.failedStep = accepted + 1;
@@ -237,9 +255,9 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     // half the pair's); a step shortened to land may be followed by one up to the size
     // proposed before, as far as its error allows
     const double taken = doubling ? 0.5 * dt : dt, takenError = doubling ? 0.5 * error : error;
-    const double allowed = takenError > 0.0 ? kSafety * std::cbrt(1.0 / takenError) : INFINITY;
+    const double allowed = localError.allowedFactor(takenError);
     proposed = lands && taken < proposed ? std::min(proposed, taken * std::max(kLargestShrink, allowed))
-                                         : taken * stepFactor(takenError);
+                                         : taken * localError.stepFactor(takenError);
     if (kink && lands) {
       localError.restart(tNew, reporter.state());
     } else {

@@ -1,9 +1,10 @@
 #pragma once
-// Adaptive steps for the one-step schemes (EEM, midpoint, trapezoidal). Each step is an
+// Adaptive steps for the one-step schemes (EEM, eem4, midpoint, trapezoidal). Each step is an
 // ordinary step of the scheme, so every accepted step keeps its balances exactly; what adapts
-// is the step size, from an estimate of the step's local error of the schemes' order
-// (dt^3 |z'''| / 12, with z''' from the third divided difference of the accepted states, and
-// step doubling where there is no such history yet: at t = 0 and after each load breakpoint).
+// is the step size, from an estimate of the step's local error of the scheme's order p
+// (C dt^(p+1) |z^(p+1)|, with z^(p+1) from the divided difference of order p + 1 of the
+// accepted states, and step doubling where there is no such history yet: at t = 0 and after
+// each load breakpoint).
 // The error is measured as IDA measures it, in the weighted RMS norm with weights
 // 1 / (rtol |z_i| + atol scale_i); a step whose norm exceeds 1 is rejected and retried
 // shorter. Steps land on the loads' breakpoints, on multiples of the output interval and on

@@ -30,10 +30,12 @@ struct LoopState {
   Eigen::VectorXd predictorStart, predictorEnd;
   double predictorTime = 0.0, predictorDt = 0.0;
   // adaptive steps: the next step to try, and the accepted states the error estimate uses
+  // (order + 1 of them; the first errorHistoryCount are set)
+  static constexpr int kMostErrorHistory = 5;
   double proposedStep = 0.0;
   int errorHistoryCount = 0;
-  std::array<double, 3> errorTimes{};
-  std::array<Eigen::VectorXd, 3> errorStates;
+  std::array<double, kMostErrorHistory> errorTimes{};
+  std::array<Eigen::VectorXd, kMostErrorHistory> errorStates;
 };
 
 struct Checkpointing {

@@ -26,8 +26,6 @@ std::optional<Method> methodByName(const std::string& name) {
   const bool adaptive =
       name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
   std::optional<Method> method = fixedStepMethod(adaptive ? name.substr(0, name.size() - suffix.size()) : name);
-  // eem4 has no error estimate of its order yet: fixed steps only
-  if (method && adaptive && method->scheme == Scheme::Eem4) return std::nullopt;
   if (method) method->name = name, method->adaptive = adaptive;
   return method;
 }

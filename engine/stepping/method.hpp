@@ -22,10 +22,10 @@ struct Method {
   bool takesTolerance() const { return isIda() || adaptive; }
 };
 
-// The names methodByName accepts, for messages; each one-step name but eem4 also takes the
-// suffix "-adaptive" (eem-adaptive, midpoint-adaptive, ...).
+// The names methodByName accepts, for messages; each one-step name also takes the suffix
+// "-adaptive" (eem-adaptive, eem4-adaptive, ...).
 inline constexpr const char* kMethodNames =
-    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal (each also as NAME-adaptive), eem4, ida";
+    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, eem4 (each also as NAME-adaptive), ida";
 std::optional<Method> methodByName(const std::string& name);
 
 struct MethodParameters {

@@ -14,7 +14,7 @@ namespace mpx {
 
 namespace {
 
-constexpr int kFormat = 1;
+constexpr int kFormat = 2;  // 2: five error-history states (eem4 adaptive)
 
 // Every field of a checkpoint, in file order, handed to visit(key, field): one list for the
 // writer (const fields) and the reader.
@@ -59,7 +59,7 @@ void visitState(State& s, Visit&& visit) {
   visit("predictor_dt", s.predictorDt);
   visit("proposed_step", s.proposedStep);
   visit("error_history_count", s.errorHistoryCount);
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < LoopState::kMostErrorHistory; ++k) {
     visit(fmt::format("error_time_{}", k), s.errorTimes[k]);
     visit(fmt::format("error_state_{}", k), s.errorStates[k]);
   }
@@ -197,7 +197,8 @@ LoopState readCheckpoint(const std::string& path, const CheckpointIdentity& expe
           fmt::format("output interval (--output-interval {:.17g}, where adaptive steps land)", found.outputInterval));
   LoopState state;
   visitState(state, reader);
-  if (state.errorHistoryCount > 3) throw InputError(path + ": error_history_count must be 0 to 3");
+  if (state.errorHistoryCount < 0 || state.errorHistoryCount > LoopState::kMostErrorHistory)
+    throw InputError(fmt::format("{}: error_history_count must be 0 to {}", path, LoopState::kMostErrorHistory));
   reader.finish();
   if (state.state.size() == 0 || state.predictorStart.size() == 0 || state.predictorEnd.size() == 0)
     throw InputError(path + ": the state or the predictor's states are empty");

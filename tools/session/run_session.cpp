@@ -98,8 +98,6 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   parameters.tEnd = request.tEnd.value_or(scene.settings.tEnd);
   parameters.newton = scene.settings.newton;
   parameters.adaptive = request.adaptive || scene.settings.adaptive || method->adaptive;
-  if (parameters.adaptive && method->scheme == Scheme::Eem4)
-    throw InputError(request.scene + ": integrator 'eem4' takes fixed steps (its adaptive steps are not built yet)");
   const double sceneAtol = scene.settings.absoluteTolerance;
   parameters.relativeTolerance = request.relativeTolerance.value_or(scene.settings.relativeTolerance);
   parameters.absoluteTolerance = request.absoluteTolerance.value_or(
