@@ -156,6 +156,19 @@ std::string jointStops(ThermalVariable) {
                  limit_damping="100" damping="0.1"/>)";
 }
 
+// Two tumbling links: a hinge under the augmented Lagrangian (multipliers at each eem4 stage)
+// and a ball joint by penalty, in gravity.
+std::string hingedLinks(ThermalVariable) {
+  return R"(<constraints enforcement="augmented_lagrangian" stiffness="1e3"/>
+    <gravity g="0 0 -9.81"/>
+    <anchor name="ground" position="0 0 0"/>
+    <body name="link1" mass="1" inertia="0.02 0.08 0.09" position="0.5 0 0" angular_velocity="0 0.6 0"/>
+    <body name="link2" mass="0.7" inertia="0.03 0.05 0.06" position="1.5 0 0" velocity="0 0.5 -0.3"
+          angular_velocity="0.2 0.6 1"/>
+    <joint name="hinge" type="revolute" a="ground" b="link1" anchor="0 0 0" axis="0 1 0"/>
+    <joint name="ball" type="spherical" a="link1" b="link2" anchor="1 0 0" enforcement="penalty" stiffness="1e4"/>)";
+}
+
 struct SceneBody {
   const char* name;
   std::string (*body)(ThermalVariable);
@@ -167,7 +180,8 @@ const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity, true},
                              {"thermo_spring_to_wall", thermoSpringToWall, true},
                              {"thermo_maxwell_chain", thermoMaxwellChain, true},
                              {"dissipative_joints", dissipativeJoints, false},
-                             {"body_point_elements", bodyPointElements, false},
+                             {"body_point_elements", bodyPointElements, true},
+                             {"hinged_links", hingedLinks, true},
                              {"joint_stops", jointStops, false}};
 
 std::string variableName(ThermalVariable variable) {

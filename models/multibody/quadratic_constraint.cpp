@@ -105,4 +105,72 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
   }
 }
 
+void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  const CollocationRule& rule = *args.rule;
+  const int l = args.stage, column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  const bool own = l == column;
+  auto r = out.residual();
+  auto K = out.tangent();
+  const double* z = args.stageState[l];
+  // the basis points of the step's polynomial: the start, then each stage
+  ConstraintVector basis[CollocationRule::kMostStages + 1];
+  basis[0] = gather(args.zOld, 0);
+  for (int j = 0; j < rule.stages; ++j) basis[j + 1] = gather(args.stageState[j], 0);
+  const ConstraintVector qEnd = gather(args.zEnd, 0);
+  for (int k = 0; k < m; ++k) {
+    const QuadraticForm& form = spec_.forms[k];
+    const bool held = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
+    double lambda[CollocationRule::kMostStages] = {};
+    if (held)
+      for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
+    // Galerkin projections onto stage l's test function, exact for these polynomial integrands:
+    // the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
+    ConstraintVector force = ConstraintVector::Zero(n), dForceDLambda = ConstraintVector::Zero(n),
+                     rateRow = ConstraintVector::Zero(n);
+    ConstraintMatrix dForce = ConstraintMatrix::Zero(n, n);
+    double rateOfPhi = 0.0;
+    for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
+      ConstraintVector q = ConstraintVector::Zero(n), rate = ConstraintVector::Zero(n);
+      for (int j = 0; j <= rule.stages; ++j) {
+        q += rule.fineValue[p][j] * basis[j];
+        rate += rule.fineRate[p][j] * basis[j];
+      }
+      double multiplier = 0.0;
+      for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
+      const double phi = form.value(q), test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
+      const ConstraintVector gradient = form.gradientAt(q);
+      const double value = multiplier + spec_.stiffness * phi, dq = rule.fineValue[p][column + 1];
+      force += (test * value) * gradient;
+      dForce += (test * dq) * (value * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+      if (!held) continue;
+      dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
+      rateOfPhi += test * gradient.dot(rate);
+      rateRow += test * (dq * form.hessian * rate + rule.fineRate[p][column + 1] * gradient);
+    }
+    r.segment(n, n) += force;
+    K.block(n, 0, n, n) += dForce;
+    if (!augmented()) continue;
+    // mu is not used (mu = 0), nor lambda of an implied form
+    const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
+    r[mu] = z[spec_.firstMultiplierDof + m + k];
+    if (own) K(mu, mu) = 1.0;
+    if (!held) {
+      r[lambdaRow] = z[spec_.firstMultiplierDof + k];
+      if (own) K(lambdaRow, lambdaRow) = 1.0;
+      continue;
+    }
+    K.block(n, lambdaRow, n, 1) += dForceDLambda;
+    // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
+    // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
+    // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
+    if (l == 0) {
+      r[lambdaRow] = form.value(qEnd);
+      K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * form.gradientAt(qEnd).transpose();
+    } else {
+      r[lambdaRow] = rateOfPhi / args.dt;
+      K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;
+    }
+  }
+}
+
 }  // namespace mpx

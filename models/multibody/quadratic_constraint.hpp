@@ -10,7 +10,10 @@
 // (which includes lambda Phi) is exact; kappa regularises the saddle point. The rate form
 // (midpoint, trapezoidal, IDA) is the stabilised index-2 GGL form with a second multiplier mu
 // per constraint: q' - v + mu grad Phi = 0, Phi(q) = 0, grad Phi . v = 0 (the multiplier
-// block is algebraic for IDA).
+// block is algebraic for IDA). In an eem4 step (docs/theory.md section 13.7) lambda is linear
+// over the step (a value per stage); the forces and the rate of Phi are projected onto the
+// stages' test functions with a quadrature exact for their polynomial integrands, so that the
+// constraint forces do no work over the step and the penalty energy's change is exact.
 #include "engine/core/component.hpp"
 
 #include <vector>
@@ -64,6 +67,8 @@ class QuadraticConstraint final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  StageForm stageForm() const override { return StageForm::Own; }
+  void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
   static std::vector<int> collectDofs(const ConstraintSpec& spec);
