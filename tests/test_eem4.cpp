@@ -111,8 +111,8 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> splitVelocity(const Model& model, co
   const int positions = model.layout().size(Block::Position);
   const Eigen::MatrixXd g = constraintJacobian(model, z), inverseMass = mass.inverse();
   const Eigen::VectorXd v = z.segment(positions, positions);
-  const Eigen::VectorXd normal = inverseMass * g.transpose() *
-                                 (g * inverseMass * g.transpose()).completeOrthogonalDecomposition().solve(g * v);
+  const Eigen::VectorXd normal =
+      inverseMass * g.transpose() * (g * inverseMass * g.transpose()).completeOrthogonalDecomposition().solve(g * v);
   return {v - normal, normal};
 }
 
@@ -194,10 +194,10 @@ INSTANTIATE_TEST_SUITE_P(LargeSteps, Eem4Balances,
                                            BalanceCase{"heated_thermo_spring.xml", 0.5, 50.0, 1e-14, kEntropyRoundOff},
                                            BalanceCase{"stiff_thermo_chain.xml", 0.25, 10.0, 1e-11, kEntropyRoundOff},
                                            BalanceCase{"double_pendulum.xml", 0.05, 5.0, 1e-10, kEntropyRoundOff},
-                                           BalanceCase{"double_pendulum_penalty.xml", 0.01, 2.0, 1e-10, kEntropyRoundOff},
+                                           BalanceCase{"double_pendulum_penalty.xml", 0.01, 2.0, 1e-10,
+                                                       kEntropyRoundOff},
                                            BalanceCase{"four_bar_revolute.xml", 0.02, 1.0, 1e-11, kEntropyRoundOff},
-                                           BalanceCase{"heavy_top.xml", 0.01, 1.0, 1e-11,
-                                                       kEntropyRoundOff}));
+                                           BalanceCase{"heavy_top.xml", 0.01, 1.0, 1e-11, kEntropyRoundOff}));
 
 // Augmented Lagrangian: the constraints hold at every step's end to Newton's tolerance (the
 // multipliers' first-stage rows ask Phi(q_end) = 0), also at a large step, without drift.

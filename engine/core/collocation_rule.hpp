@@ -70,7 +70,7 @@ inline CollocationRule gaussCollocation(int stages) {
                outer = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(6.0 / 5.0));
   const double innerWeight = (18.0 + std::sqrt(30.0)) / 36.0, outerWeight = (18.0 - std::sqrt(30.0)) / 36.0;
   const std::array<double, CollocationRule::kFinePoints> x = {-outer, -inner, inner, outer},
-                                                          w = {outerWeight, innerWeight, innerWeight, outerWeight};
+                                                         w = {outerWeight, innerWeight, innerWeight, outerWeight};
   for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
     rule.fineNode[p] = 0.5 * (1.0 + x[p]);
     rule.fineWeight[p] = 0.5 * w[p];

@@ -23,7 +23,8 @@ CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& patte
   // internal variables, numbered as in the velocity-condensed system (one-stage systems only)
   const SparseMatrix& stage = velocities_ > 0 ? reduced_ : pattern;
   const int velocitiesBefore = velocities_ > 0 ? layout.size(Block::Velocity) : 0;
-  internal_.build(stage, layout.offset(Block::Internal) - velocitiesBefore, stages == 1 ? layout.size(Block::Internal) : 0);
+  internal_.build(stage, layout.offset(Block::Internal) - velocitiesBefore,
+                  stages == 1 ? layout.size(Block::Internal) : 0);
   internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
   internalSolution_.resize(stage.rows());
   lu_ = makeSparseLu(static_cast<int>(factorised().rows()));
@@ -83,8 +84,8 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   }
   kinematicColumnStart_[n] = static_cast<int>(kinematicColumns_.size());
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
-    wholeSystemReason_ =
-        "position " + dofName(kinematicRow_[missing - pivotEntry_.begin()]) + " has no kinematic row (no inertia owns it)";
+    wholeSystemReason_ = "position " + dofName(kinematicRow_[missing - pivotEntry_.begin()]) +
+                         " has no kinematic row (no inertia owns it)";
     return false;
   }
 

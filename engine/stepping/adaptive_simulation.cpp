@@ -53,9 +53,7 @@ class LocalError {
   double allowedFactor(double error) const {
     return error > 0.0 ? kSafety * std::pow(error, -1.0 / (order_ + 1)) : INFINITY;
   }
-  double stepFactor(double error) const {
-    return std::clamp(allowedFactor(error), kLargestShrink, kLargestGrowth);
-  }
+  double stepFactor(double error) const { return std::clamp(allowedFactor(error), kLargestShrink, kLargestGrowth); }
 
   // Start a new smooth stretch at (t, z): the loads have a kink here, or the run starts.
   void restart(double t, const Eigen::VectorXd& z) {
