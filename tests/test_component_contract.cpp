@@ -26,7 +26,9 @@ class FakeSpring final : public Component {
                            velocityShift + 4, velocityShift + 5}),
         honestRows_(honestRows) {}
 
-  bool couples(int row, int column) const override { return honestRows_ ? row >= 6 : Component::couples(row, column); }
+  bool couples(int row, int column, LocalForm form) const override {
+    return honestRows_ ? row >= 6 : Component::couples(row, column, form);
+  }
   void measure(const double*, Measures&) const override {}
   void eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows& flows) const override {
     write(args.zOld, args.zNew, out);

@@ -96,7 +96,7 @@ Eigen::MatrixXd constraintJacobian(const Model& model, const Eigen::VectorXd& z)
 // The mass matrix: the derivative of the momentum rows' rate form with respect to vdot.
 Eigen::MatrixXd massMatrix(const Model& model) {
   const Eigen::VectorXd z = model.initialState(), zdot = Eigen::VectorXd::Zero(z.size());
-  Assembler assembler(model);
+  Assembler assembler(model, Component::LocalForm::Rate);
   Workspace ws = model.makeWorkspace();
   assembler.clear();
   assembler.addRate(model, ws, {z.data(), zdot.data(), 0.0, 0.0, 1.0}, 1.0);

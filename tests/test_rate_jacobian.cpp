@@ -23,7 +23,7 @@ class RateJacobian : public ::testing::TestWithParam<const char*> {};
 TEST_P(RateJacobian, MatchesCentralDifferences) {
   const CompiledScene scene = loadScene(scenePath(GetParam()));
   const Model& model = *scene.model;
-  Assembler assembler(model);
+  Assembler assembler(model, Component::LocalForm::Rate);
   Workspace workspace = model.makeWorkspace();
   VectorXd z = model.initialState() + 1e-3 * randomIsh(magnitudeAt(model, model.initialState()), 23);
   // velocities of their own size: dampers and friction take their rates from them, and a
@@ -61,7 +61,7 @@ TEST(ResidualOnlyEvaluation, MatchesTheFullOne) {
     SCOPED_TRACE(file);
     const CompiledScene scene = loadScene(scenePath(file));
     const Model& model = *scene.model;
-    Assembler assembler(model);
+    Assembler assembler(model, Component::LocalForm::Rate);
     Workspace workspace = model.makeWorkspace();
     const VectorXd z = model.initialState() + 1e-3 * randomIsh(magnitudeAt(model, model.initialState()), 23);
     const VectorXd zdot = randomIsh(magnitudeAt(model, z), 29);

@@ -128,9 +128,12 @@ class Component {
   // Coupling components (heat links) read node temperatures published by the others, so
   // they are evaluated after all non-coupling components.
   virtual bool isCoupling() const { return false; }
-  // Whether local residual row `row` may depend on local dof `column`. The tangent's sparsity
-  // pattern holds only such pairs; entries a component writes elsewhere are dropped.
-  virtual bool couples(int /*row*/, int /*column*/) const { return true; }
+  // Whether local residual row `row` may depend on local dof `column` in the local form the
+  // engine assembles (eemLocal, rateLocal or, for eem4, stageLocal and rateLocal at the
+  // stages). The tangent's sparsity pattern holds only such pairs; entries a component
+  // writes elsewhere are dropped.
+  enum class LocalForm { Step, Rate, Stages };
+  virtual bool couples(int /*row*/, int /*column*/, LocalForm /*form*/) const { return true; }
 
   // Add energy, entropy, momenta and node temperatures of state z.
   virtual void measure(const double* z, Measures& out) const = 0;

@@ -12,7 +12,8 @@
 
 namespace mpx {
 
-Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(model.layout().total()) {
+Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
+    : stages_(stages), size_(model.layout().total()) {
   const int n = size_, unknowns = stages * n;
   residual_ = Eigen::VectorXd::Zero(unknowns);
   rowScale_ = Eigen::VectorXd::Zero(unknowns);
@@ -24,8 +25,8 @@ Assembler::Assembler(const Model& model, int stages) : stages_(stages), size_(mo
   const Layout& layout = model.layout();
   auto inBlock = [&](const Component& component, int rowStage, int columnStage, int i, int j) {
     const int row = component.dofs()[i], column = component.dofs()[j];
-    return component.couples(i, j) && (rowStage == columnStage || layout.blockOf(row) != Block::Position ||
-                                       layout.blockOf(column) != Block::Velocity);
+    return component.couples(i, j, form) && (rowStage == columnStage || layout.blockOf(row) != Block::Position ||
+                                             layout.blockOf(column) != Block::Velocity);
   };
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < unknowns; ++i) entries.emplace_back(i, i, 0.0);

@@ -18,10 +18,11 @@ namespace mpx {
 
 class Assembler {
  public:
-  // `stages` > 1: the system of an eem4 step, whose unknowns are the values of each stage
-  // (stage l's dof i at l n + i) and whose tangent has one block of the model's pattern per
-  // pair of stages.
-  explicit Assembler(const Model& model, int stages = 1);
+  // The pattern is that of the local form `form` the components will be evaluated in.
+  // `stages` > 1 (form Stages): the system of an eem4 step, whose unknowns are the values of
+  // each stage (stage l's dof i at l n + i) and whose tangent has one block of the model's
+  // pattern per pair of stages.
+  Assembler(const Model& model, Component::LocalForm form, int stages = 1);
   // The local systems point into the assembler's own buffers.
   Assembler(const Assembler&) = delete;
   Assembler& operator=(const Assembler&) = delete;

@@ -85,7 +85,7 @@ class IdaProblem {
 
 IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
     : model_(model),
-      assembler_(model),
+      assembler_(model, Component::LocalForm::Rate),
       workspace_(model.makeWorkspace()),
       modelSize_(model.layout().total()),
       relativeTolerance_(options.relativeTolerance),

@@ -8,6 +8,12 @@ namespace mpx {
 namespace {
 // Backtracking gives up (and the step is cut back) below this fraction of a Newton step.
 constexpr double kSmallestLineSearchStep = 1.0 / 1024;
+
+// The components' local form each scheme evaluates.
+Component::LocalForm localForm(Scheme scheme) {
+  if (scheme == Scheme::Eem) return Component::LocalForm::Step;
+  return scheme == Scheme::Eem4 ? Component::LocalForm::Stages : Component::LocalForm::Rate;
+}
 }  // namespace
 
 Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings settings)
@@ -15,7 +21,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       scheme_(scheme),
       settings_(settings),
       rule_(gaussCollocation(scheme == Scheme::Eem4 ? 2 : 1)),
-      assembler_(model, rule_.stages),
+      assembler_(model, localForm(scheme), rule_.stages),
       solver_(model.layout(), assembler_.tangent()),
       workspace_(model.makeWorkspace()),
       zMid_(model.layout().total()),

@@ -51,7 +51,7 @@ class SolidElement final : public Component {
   // of a point on positions, temperatures (through the viscosity) and that point's own strains;
   // nothing depends on velocities
   // (a rate-form thermal row does, on the position rates, which share the position columns)
-  bool couples(int row, int column) const override {
+  bool couples(int row, int column, LocalForm) const override {
     const int strains = 6 * nodes_;
     if (row < 3 * nodes_ || (column >= 3 * nodes_ && column < strains)) return false;
     const bool strainRow = row >= strains && row < firstThermal_,

@@ -23,7 +23,7 @@ SolidInertia::SolidInertia(const SolidInertiaSpec& spec)
   weight_ = spec.gravity * mass_.rowwise().sum().transpose();
 }
 
-bool SolidInertia::couples(int row, int column) const {
+bool SolidInertia::couples(int row, int column, LocalForm) const {
   const int velocities = 3 * nodes_;
   if (row < velocities) return ownsNode_[row / 3] && (column == row || column == row + velocities);
   // momentum row of component i couples to component i of every node's velocity

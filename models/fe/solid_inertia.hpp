@@ -26,7 +26,7 @@ class SolidInertia final : public Component {
  public:
   explicit SolidInertia(const SolidInertiaSpec& spec);
 
-  bool couples(int row, int column) const override;
+  bool couples(int row, int column, LocalForm) const override;
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

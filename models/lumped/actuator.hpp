@@ -14,7 +14,7 @@ class Actuator final : public Component {
   Actuator(std::string name, const Endpoint& a, const Endpoint& b, double force, TimeFunction profile);
 
   // writes momentum rows only
-  bool couples(int row, int) const override { return !geometry_.isPosition(row); }
+  bool couples(int row, int, LocalForm) const override { return !geometry_.isPosition(row); }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -44,7 +44,7 @@ class LumpedElement final : public Component {
   explicit LumpedElement(LumpedElementSpec spec);
 
   // writes momentum, thermal and internal rows, never the end points' kinematic rows
-  bool couples(int row, int) const override { return !geometry_ || !geometry_->isPosition(row); }
+  bool couples(int row, int, LocalForm) const override { return !geometry_ || !geometry_->isPosition(row); }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

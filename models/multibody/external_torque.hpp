@@ -14,7 +14,7 @@ class ExternalTorque final : public Component {
   ExternalTorque(std::string name, int firstDirectorDof, int velocityShift, const Vec3& torque, TimeFunction profile);
 
   // local order: 9 director positions, their 9 velocity rows; writes the velocity rows only
-  bool couples(int row, int) const override { return row >= 9; }
+  bool couples(int row, int, LocalForm) const override { return row >= 9; }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -20,7 +20,7 @@ class Inertia final : public Component {
           const Vec3& gravity);
 
   // kinematic rows: the dof's own position and velocity; momentum rows: its own velocity
-  bool couples(int row, int column) const override {
+  bool couples(int row, int column, LocalForm) const override {
     const int velocityRows = 3 * static_cast<int>(blocks_.size());
     return column == row || (row < velocityRows && column == row + velocityRows);
   }

@@ -51,7 +51,7 @@ class JointForce final : public Component {
   explicit JointForce(JointForceSpec spec);
 
   // local order q, v, heat, internal: writes every row but the kinematic ones
-  bool couples(int row, int) const override { return row >= static_cast<int>(spec_.positionDofs.size()); }
+  bool couples(int row, int, LocalForm) const override { return row >= static_cast<int>(spec_.positionDofs.size()); }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -51,9 +51,11 @@ class QuadraticConstraint final : public Component {
  public:
   explicit QuadraticConstraint(ConstraintSpec spec);
 
-  // GGL's kinematic rows see the positions and mu only (local order: q, v, lambda, mu)
-  bool couples(int row, int column) const override {
+  // only GGL's kinematic rows (the rate form) see the positions and mu; the step and stage
+  // forms leave the kinematic rows alone (local order: q, v, lambda, mu)
+  bool couples(int row, int column, LocalForm form) const override {
     const int mus = 2 * positionCount_ + static_cast<int>(spec_.forms.size());
+    if (form != LocalForm::Rate) return row >= positionCount_;
     return row >= positionCount_ || column < positionCount_ || column >= mus;
   }
   const ConstraintSpec& spec() const { return spec_; }

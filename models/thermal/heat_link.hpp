@@ -22,7 +22,7 @@ class HeatLink final : public Component {
 
   bool isCoupling() const override { return true; }
   // writes the two thermal rows only
-  bool couples(int row, int) const override { return row == localThermal_[0] || row == localThermal_[1]; }
+  bool couples(int row, int, LocalForm) const override { return row == localThermal_[0] || row == localThermal_[1]; }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

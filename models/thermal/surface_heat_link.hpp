@@ -18,7 +18,7 @@ class SurfaceHeatLink final : public Component {
 
   bool isCoupling() const override { return true; }
   // writes the solid node's row and the lumped node's row only
-  bool couples(int row, int) const override { return row == 0 || row == lumpedRow_; }
+  bool couples(int row, int, LocalForm) const override { return row == 0 || row == lumpedRow_; }
   void measure(const double*, Measures&) const override {}
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
