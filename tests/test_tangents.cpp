@@ -172,17 +172,16 @@ std::string hingedLinks(ThermalVariable) {
 struct SceneBody {
   const char* name;
   std::string (*body)(ThermalVariable);
-  bool hasStageForms;  // every element has an eem4 form
 };
 
-const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity, true},
-                             {"maxwell_with_dampers", maxwellWithDampers, true},
-                             {"thermo_spring_to_wall", thermoSpringToWall, true},
-                             {"thermo_maxwell_chain", thermoMaxwellChain, true},
-                             {"dissipative_joints", dissipativeJoints, false},
-                             {"body_point_elements", bodyPointElements, true},
-                             {"hinged_links", hingedLinks, true},
-                             {"joint_stops", jointStops, false}};
+const SceneBody kScenes[] = {{"spring_in_gravity", springInGravity},
+                             {"maxwell_with_dampers", maxwellWithDampers},
+                             {"thermo_spring_to_wall", thermoSpringToWall},
+                             {"thermo_maxwell_chain", thermoMaxwellChain},
+                             {"dissipative_joints", dissipativeJoints},
+                             {"body_point_elements", bodyPointElements},
+                             {"hinged_links", hingedLinks},
+                             {"joint_stops", jointStops}};
 
 std::string variableName(ThermalVariable variable) {
   return variable == ThermalVariable::Temperature ? "temperature" : "entropy";
@@ -212,7 +211,6 @@ std::vector<StepCase> stepCases() {
         for (Scheme scheme : {Scheme::Eem, Scheme::Eem4, Scheme::Midpoint, Scheme::Trapezoidal}) {
           // the discrete-gradient form only matters to EEM
           if (scheme != Scheme::Eem && form == DiscreteGradientForm::Gonzalez) continue;
-          if (scheme == Scheme::Eem4 && !scene.hasStageForms) continue;
           cases.push_back({&scene, variable, form, scheme});
         }
   return cases;

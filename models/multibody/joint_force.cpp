@@ -1,5 +1,7 @@
 #include "models/multibody/joint_force.hpp"
 
+#include "engine/core/stage_gradient.hpp"
+
 #include <cmath>
 
 namespace mpx {
@@ -220,20 +222,16 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
   deposit(power, dPowerDq, ConstraintRow::Zero(n_), dPowerDgamma, out, flows);
 }
 
-void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
-  // the coordinate rate from the velocities, not from the position rates: under constraints the
-  // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
-  // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
-  const ConstraintVector q = gather(args.z, 0), qRate = gather(args.z, spec_.velocityShift);
-  const Vec3 a = arguments(args.z);
+double JointForce::addDissipativeForce(const ConstraintVector& q, const Vec3& a, const ConstraintVector& v,
+                                       const ArgumentJacobian& J, double alpha, LocalSystem& out,
+                                       ConstraintRow& dPowerDq, ConstraintRow& dPowerDv) const {
   const int m = static_cast<int>(spec_.invariants.size());
-  const ArgumentJacobian J = invariantJacobian(q);
-  const Jet e = energy(a), angle = jointCoordinateChart(spec_.revolute, a, a);
-  const Vec3 invariantRate = J * qRate;
+  const Jet angle = jointCoordinateChart(spec_.revolute, a, a);
+  const Vec3 invariantRate = J * v;
   const double rate = angle.grad.dot(invariantRate);
   // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dv
   ConstraintRow dRateDq = (angle.hess * invariantRate).transpose() * J;
-  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * qRate).transpose();
+  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * v).transpose();
   const ConstraintRow dRateDv = angle.grad.transpose() * J;
   double dForce = 0.0;
   double force = dissipativeForce(rate, &dForce);
@@ -246,19 +244,33 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
     dForceDq += coefficient * dRateDq + (2.0 * c * rate * p.depth) * (p.grad.transpose() * J);
     dForceDv += coefficient * dRateDv;
   }
-  const Vec3 forceOnArguments = e.grad + force * angle.grad;
+  auto K = out.tangent();
+  const ConstraintVector direction = J.transpose() * angle.grad;
+  out.residual().segment(n_, n_) += force * direction;
+  K.block(n_, 0, n_, n_) += alpha * (force * J.transpose() * angle.hess * J + direction * dForceDq);
+  K.block(n_, n_, n_, n_) += alpha * direction * dForceDv;
+  for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += (alpha * force * angle.grad[i]) * spec_.invariants[i].hessian;
+  dPowerDq = alpha * (rate * dForceDq + force * dRateDq);
+  dPowerDv = alpha * (rate * dForceDv + force * dRateDv);
+  return force * rate;
+}
+
+void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  const ConstraintVector q = gather(args.z, 0);
+  const Vec3 a = arguments(args.z);
+  const int m = static_cast<int>(spec_.invariants.size());
+  const ArgumentJacobian J = invariantJacobian(q);
+  const Jet e = energy(a);
   auto r = out.residual();
   auto K = out.tangent();
-  r.segment(n_, n_) += J.transpose() * forceOnArguments;
-
-  const ConstraintVector direction = J.transpose() * angle.grad;
-  K.block(n_, 0, n_, n_) += args.alpha * (J.transpose() * (e.hess + force * angle.hess) * J + direction * dForceDq);
-  K.block(n_, n_, n_, n_) += args.alpha * direction * dForceDv;
-  for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * forceOnArguments[i] * spec_.invariants[i].hessian;
-
-  double power = force * rate;
-  ConstraintRow dPowerDq = args.alpha * (rate * dForceDq + force * dRateDq);
-  const ConstraintRow dPowerDv = args.alpha * (rate * dForceDv + force * dRateDv);
+  r.segment(n_, n_) += J.transpose() * e.grad;
+  K.block(n_, 0, n_, n_) += args.alpha * J.transpose() * e.hess * J;
+  for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * e.grad[i] * spec_.invariants[i].hessian;
+  // the coordinate rate from the velocities, not from the position rates: under constraints the
+  // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
+  // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
+  ConstraintRow dPowerDq, dPowerDv;
+  double power = addDissipativeForce(q, a, gather(args.z, spec_.velocityShift), J, args.alpha, out, dPowerDq, dPowerDv);
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     // nu gamma' = -de/dgamma, dissipating (de/dgamma)^2 / nu
@@ -271,6 +283,68 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
     power += g * g / nu;
     dPowerDq += args.alpha * (2.0 * g / nu) * dgDq;
     dPowerDgamma = -args.alpha * (2.0 * g / nu) * e.hess(kInternal, kInternal);
+  }
+  deposit(power, dPowerDq, dPowerDv, dPowerDgamma, out, flows);
+}
+
+void JointForce::argumentRows(const double* z, int count, LocalRow (&rows)[3]) const {
+  const ConstraintVector q = gather(z, 0);
+  for (LocalRow& row : rows) row = LocalRow::Zero(count);
+  for (std::size_t i = 0; i < spec_.invariants.size(); ++i)
+    rows[i].head(n_) = spec_.invariants[i].gradientAt(q).transpose();
+  if (localInternal_ >= 0) rows[kInternal][localInternal_] = 1.0;
+}
+
+void JointForce::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  const CollocationRule& rule = *args.rule;
+  const int l = args.stage, column = args.column, m = static_cast<int>(spec_.invariants.size());
+  const bool own = l == column;
+  // the arguments (I, gamma) along the stage polynomial, with their tau-rates
+  StagePath path;
+  path.column = column;
+  path.start = arguments(args.zOld);
+  path.end = arguments(args.zEnd);
+  argumentRows(args.zEnd, out.n, path.endRows);
+  for (int j = 0; j < rule.stages; ++j) {
+    const ConstraintVector q = gather(args.stageState[j], 0), qRate = args.dt * gather(args.stageRate[j], 0);
+    path.value[j] = arguments(args.stageState[j]);
+    path.rate[j] = Vec3::Zero();
+    for (int i = 0; i < m; ++i) path.rate[j][i] = spec_.invariants[i].gradientAt(q).dot(qRate);
+    if (localInternal_ >= 0) path.rate[j][kInternal] = args.dt * args.stageRate[j][spec_.internalDof];
+    argumentRows(args.stageState[j], out.n, path.rows[j]);
+    // a'_j through the rates (coefficient rule.rate) and, for I, through grad I on its own stage
+    for (int i = 0; i < 3; ++i) path.rateRows[j][i] = rule.rate[j][column + 1] * path.rows[j][i];
+    if (j == column)
+      for (int i = 0; i < m; ++i) path.rateRows[j][i].head(n_) += (spec_.invariants[i].hessian * qRate).transpose();
+  }
+  const GradientRows dEnergy =
+      consistentGradient([&](const Vec3& a) { return energy(a); }, mask(), Vec3::Ones(), rule, path, l);
+
+  // the stored energy's pull at the stage, then the dissipative forces in rate form there
+  const double* z = args.stageState[l];
+  const ConstraintVector q = gather(z, 0);
+  const ArgumentJacobian J = invariantJacobian(q);
+  auto r = out.residual();
+  auto K = out.tangent();
+  r.segment(n_, n_) += J.transpose() * dEnergy.grad;
+  for (int i = 0; i < m; ++i) {
+    K.block(n_, 0, n_, out.n) += J.row(i).transpose() * dEnergy.d[i];
+    if (own) K.block(n_, 0, n_, n_) += dEnergy.grad[i] * spec_.invariants[i].hessian;
+  }
+  ConstraintRow dPowerDq, dPowerDv;
+  double power = addDissipativeForce(q, path.value[l], gather(z, spec_.velocityShift), J, own ? 1.0 : 0.0, out,
+                                     dPowerDq, dPowerDv);
+  double dPowerDgamma = 0.0;
+  if (localInternal_ >= 0) {
+    // Maxwell branch: nu gamma' = g with g = -D_gamma e at the stage, dissipating g^2 / nu
+    const double nu = spec_.viscosity, g = -dEnergy.grad[kInternal];
+    const LocalRow dg = -dEnergy.d[kInternal];
+    r[localInternal_] = nu * args.stageRate[l][spec_.internalDof] - g;
+    K.row(localInternal_) -= dg;
+    K(localInternal_, localInternal_) += nu * rule.rate[l][column + 1] / args.dt;
+    power += g * g / nu;
+    dPowerDq += (2.0 * g / nu) * dg.head(n_);
+    dPowerDgamma = (2.0 * g / nu) * dg[localInternal_];
   }
   deposit(power, dPowerDq, dPowerDv, dPowerDgamma, out, flows);
 }

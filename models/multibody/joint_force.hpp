@@ -55,6 +55,10 @@ class JointForce final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: the energy-consistent stage gradient of e(I, gamma) (docs/theory.md section 13.2) and
+  // the dissipative forces in their rate form at each stage
+  StageForm stageForm() const override { return StageForm::Own; }
+  void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
   static std::vector<int> collectDofs(const JointForceSpec& spec);
@@ -78,6 +82,15 @@ class JointForce final : public Component {
   // d(I_0, I_1, gamma)/dq at q: one row per argument slot, zero for gamma and unused slots.
   using ArgumentJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxConstrainedDofs>;
   ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;
+  // The rows of d(I_0, I_1, gamma)/dz over all `count` local dofs at z.
+  void argumentRows(const double* z, int count, LocalRow (&rows)[3]) const;
+  // The dissipative force f along the coordinate (damper, friction, stop damping) at positions
+  // q, arguments a and velocities v, in rate form: adds its pull to the momentum rows with the
+  // tangent alpha d/d(q, v) and returns its power f rate, with the power's derivatives (times
+  // alpha).
+  double addDissipativeForce(const ConstraintVector& q, const Vec3& a, const ConstraintVector& v,
+                             const ArgumentJacobian& J, double alpha, LocalSystem& out, ConstraintRow& dPowerDq,
+                             ConstraintRow& dPowerDv) const;
   unsigned mask() const;
   // Send the dissipated power (with its tangent row over q, v and gamma) to the heat node, or
   // to the flows.
