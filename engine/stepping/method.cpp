@@ -36,9 +36,9 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
       if (component->stageForm() == Component::StageForm::None)
         throw InputError(
             scene + ": integrator '" + method.name + "' has no fourth-order form for element '" + component->name() +
-            "' yet (eem4 covers masses, rigid bodies and their joints, springs, thermo-springs, Maxwell "
-            "elements, dampers, heat links, reservoirs, fixed temperatures, forces, torques and actuators; "
-            "docs/theory.md section 13)");
+            "' yet (eem4 covers masses, rigid bodies, their joints and joint forces, springs, "
+            "thermo-springs, Maxwell elements, dampers, heat links, reservoirs, fixed temperatures, forces, "
+            "torques and actuators, but not FE solids; docs/theory.md section 13)");
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.kind == PrescribedKind::Displacement)
