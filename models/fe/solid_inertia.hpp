@@ -30,6 +30,8 @@ class SolidInertia final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: a kinetic energy quadratic in the velocities and a constant weight
+  StageForm stageForm() const override { return StageForm::RateAtStages; }
 
  private:
   using NodeVectors = Eigen::Matrix<double, 3, kMaxCellNodes>;
