@@ -62,8 +62,8 @@ class SolidElement final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
-  // eem4 (models/fe/solid_element_stages.cpp): hyperelastic cells; viscous and thermal cells
-  // have no stage form yet
+  // eem4 (models/fe/solid_element_stages.cpp): hyperelastic and viscoelastic cells; thermal
+  // cells have no stage form yet
   StageForm stageForm() const override;
   void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
