@@ -222,9 +222,9 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
   deposit(power, dPowerDq, ConstraintRow::Zero(n_), dPowerDgamma, out, flows);
 }
 
-double JointForce::addDissipativeForce(const ConstraintVector& q, const Vec3& a, const ConstraintVector& v,
-                                       const ArgumentJacobian& J, double alpha, LocalSystem& out,
-                                       ConstraintRow& dPowerDq, ConstraintRow& dPowerDv) const {
+double JointForce::addDissipativeForce(const Vec3& a, const ConstraintVector& v, const ArgumentJacobian& J,
+                                       double alpha, LocalSystem& out, ConstraintRow& dPowerDq,
+                                       ConstraintRow& dPowerDv) const {
   const int m = static_cast<int>(spec_.invariants.size());
   const Jet angle = jointCoordinateChart(spec_.revolute, a, a);
   const Vec3 invariantRate = J * v;
@@ -270,7 +270,7 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
   // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
   // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
   ConstraintRow dPowerDq, dPowerDv;
-  double power = addDissipativeForce(q, a, gather(args.z, spec_.velocityShift), J, args.alpha, out, dPowerDq, dPowerDv);
+  double power = addDissipativeForce(a, gather(args.z, spec_.velocityShift), J, args.alpha, out, dPowerDq, dPowerDv);
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     // nu gamma' = -de/dgamma, dissipating (de/dgamma)^2 / nu
@@ -332,8 +332,8 @@ void JointForce::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out,
     if (own) K.block(n_, 0, n_, n_) += dEnergy.grad[i] * spec_.invariants[i].hessian;
   }
   ConstraintRow dPowerDq, dPowerDv;
-  double power = addDissipativeForce(q, path.value[l], gather(z, spec_.velocityShift), J, own ? 1.0 : 0.0, out,
-                                     dPowerDq, dPowerDv);
+  double power =
+      addDissipativeForce(path.value[l], gather(z, spec_.velocityShift), J, own ? 1.0 : 0.0, out, dPowerDq, dPowerDv);
   double dPowerDgamma = 0.0;
   if (localInternal_ >= 0) {
     // Maxwell branch: nu gamma' = g with g = -D_gamma e at the stage, dissipating g^2 / nu

@@ -84,13 +84,12 @@ class JointForce final : public Component {
   ArgumentJacobian invariantJacobian(const ConstraintVector& q) const;
   // The rows of d(I_0, I_1, gamma)/dz over all `count` local dofs at z.
   void argumentRows(const double* z, int count, LocalRow (&rows)[3]) const;
-  // The dissipative force f along the coordinate (damper, friction, stop damping) at positions
-  // q, arguments a and velocities v, in rate form: adds its pull to the momentum rows with the
-  // tangent alpha d/d(q, v) and returns its power f rate, with the power's derivatives (times
-  // alpha).
-  double addDissipativeForce(const ConstraintVector& q, const Vec3& a, const ConstraintVector& v,
-                             const ArgumentJacobian& J, double alpha, LocalSystem& out, ConstraintRow& dPowerDq,
-                             ConstraintRow& dPowerDv) const;
+  // The dissipative force f along the coordinate (damper, friction, stop damping) at arguments
+  // a, invariant Jacobian J and velocities v, in rate form: adds its pull to the momentum rows
+  // with the tangent alpha d/d(q, v) and returns its power f rate, with the power's derivatives
+  // (times alpha).
+  double addDissipativeForce(const Vec3& a, const ConstraintVector& v, const ArgumentJacobian& J, double alpha,
+                             LocalSystem& out, ConstraintRow& dPowerDq, ConstraintRow& dPowerDv) const;
   unsigned mask() const;
   // Send the dissipated power (with its tangent row over q, v and gamma) to the heat node, or
   // to the flows.
