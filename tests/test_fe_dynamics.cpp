@@ -372,7 +372,8 @@ TEST(ViscoelasticLBlock, EemKeepsEnergyPlusDissipationAndMomentaWhileEnergyDecay
 }
 
 // ---------------------------------------------------------------------------------------------
-// 5. Order in time: the L-block under its load up to t = 1, from step dt0 halved four times.
+// 5. Order in time: the L-block under its load up to t = 1, from a largest step halved a few
+// times.
 // The differences of successive final positions (Euclidean norm) fall by 2^p per halving for
 // a scheme of order p: a Richardson estimate of the error that needs no reference run. The
 // L-block's stiff modes keep dt = 0.1 outside EEM's asymptotic range (slope 1.7 there); eem4

@@ -4,6 +4,7 @@
 // Gauss-Legendre nodes t + c_l dt, and the rate form holds at each node. It is the continuous
 // Galerkin time finite element cG(s) with s-point Gauss quadrature, of order 2s.
 #include <array>
+#include <cassert>
 #include <cmath>
 
 namespace mpx {
@@ -30,6 +31,7 @@ struct CollocationRule {
 
 // The s-stage rule (s = 1, 2: orders 2, 4), from the Lagrange basis on {0, c_1..c_s}.
 inline CollocationRule gaussCollocation(int stages) {
+  assert(stages >= 1 && stages <= CollocationRule::kMostStages);
   CollocationRule rule;
   rule.stages = stages;
   const double r3 = std::sqrt(3.0) / 6.0;

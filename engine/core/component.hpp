@@ -131,7 +131,8 @@ class Component {
   // Whether local residual row `row` may depend on local dof `column` in the local form the
   // engine assembles (eemLocal, rateLocal or, for eem4, stageLocal and rateLocal at the
   // stages). The tangent's sparsity pattern holds only such pairs; entries a component
-  // writes elsewhere are dropped.
+  // writes elsewhere are dropped. A component that takes its rate form at the stages
+  // (RateAtStages) must answer for Stages as for Rate.
   enum class LocalForm { Step, Rate, Stages };
   virtual bool couples(int /*row*/, int /*column*/, LocalForm /*form*/) const { return true; }
 

@@ -39,6 +39,15 @@ struct StagePath {
 // of 1e-5 per step.
 inline constexpr double kStagePathFloor = 1e-10;
 
+// A norm N with the floor: N + k^2 / (N + k), and its derivative with respect to N.
+struct FlooredNorm {
+  double value, slope;
+};
+inline FlooredNorm flooredNorm(double norm) {
+  const double floorRatio = kStagePathFloor / (norm + kStagePathFloor);
+  return {norm + kStagePathFloor * floorRatio, 1.0 - floorRatio * floorRatio};
+}
+
 // D psi at stage `stage` and its derivative with respect to stage path.column's values; f maps
 // a Vec3 to a Jet, `mask` selects the active arguments.
 template <class Fn>
@@ -65,9 +74,9 @@ GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, c
   for (int i = 0; i < 3; ++i)
     out.d[i] = stage == k ? alongRows(jet[stage].hess.row(i).transpose(), path.rows[stage]) : LocalRow::Zero(n);
   // mu and its derivative, from those of the defect and of the floored norm
-  const double floorRatio = kStagePathFloor / (norm + kStagePathFloor);
-  const double dFlooredDNorm = 1.0 - floorRatio * floorRatio;
-  norm += kStagePathFloor * floorRatio;
+  const FlooredNorm floored = flooredNorm(norm);
+  const double dFlooredDNorm = floored.slope;
+  norm = floored.value;
   const double mu = defect / norm;
   LocalRow dDefect = rule.end[k + 1] * alongRows(endJet.grad, path.endRows);
   LocalRow dNorm = LocalRow::Zero(n);

@@ -103,7 +103,7 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
     if (isVelocity(column)) continue;
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) mark(static_cast<int>(it.row()));
     for (int k = kinematicColumnStart_[column]; k < kinematicColumnStart_[column + 1]; ++k)
-      for (SparseMatrix::InnerIterator it(pattern, velocityOf(kinematicColumns_[k].position)); it; ++it)
+      for (SparseMatrix::InnerIterator it(pattern, velocityOf(kinematicColumns_[k].row)); it; ++it)
         mark(static_cast<int>(it.row()));
     for (const int row : rows) {
       entries.emplace_back(row, reducedIndex_[column], 0.0);

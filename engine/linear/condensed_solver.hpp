@@ -7,10 +7,11 @@
 // unknowns only, with the momentum rows in place of the kinematic ones: half the size for
 // mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
 // A collocation step's system (eem4: the layout once per stage) is condensed stage by stage
-// in the same way. Scenes whose pattern does not have this structure are solved whole. Internal variables that
-// split into small independent groups (per quadrature point, per Maxwell element) are then
-// eliminated as well (engine/linear/group_elimination), so that what is factorised is the system of
-// positions, thermal unknowns and multipliers.
+// in the same way. Scenes whose pattern does not have this structure are solved whole. In a
+// one-stage system, internal variables that split into small independent groups (per
+// quadrature point, per Maxwell element) are then eliminated as well
+// (engine/linear/group_elimination), so that what is factorised is the system of positions,
+// thermal unknowns and multipliers.
 #include "engine/core/layout.hpp"
 #include "engine/linear/group_elimination.hpp"
 #include "engine/linear/sparse_lu.hpp"
@@ -51,7 +52,7 @@ class CondensedSolver {
   };
   // The same entry seen from its column: the kinematic row i and its place in K.
   struct ColumnEntry {
-    int position, entry;
+    int row, entry;
   };
   // The maps below for `stages` copies of a layout of n dofs with `positions` positions.
   void numberUnknowns(int n, int positions, int stages);
@@ -85,8 +86,8 @@ class CondensedSolver {
   const Eigen::SparseMatrix<double>* pattern_;
   const Eigen::SparseMatrix<double>* tangent_ = nullptr;
   Eigen::SparseMatrix<double> reduced_;
-  std::vector<int> pivotEntry_;                       // per q_i: position of d_i in K
-  std::vector<std::vector<RowEntry>> kinematicRows_;  // per q_i
+  std::vector<int> pivotEntry_;                       // per kinematic row i (all stages): place of d_i in K
+  std::vector<std::vector<RowEntry>> kinematicRows_;  // per kinematic row i (all stages)
   // the kinematic entries of column c of K are kinematicColumns_[kinematicColumnStart_[c] ...
   // kinematicColumnStart_[c + 1]), in the order of i
   std::vector<ColumnEntry> kinematicColumns_;

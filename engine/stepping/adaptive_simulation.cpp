@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <vector>
 
 namespace mpx {
@@ -23,8 +24,8 @@ constexpr double kSmallestStepFraction = 1e-12;
 // left out, as IDA leaves out algebraic variables. So are velocities: each step's mean velocity
 // is its position difference quotient, so their error shows in the positions one step later,
 // while under constraints the end-point velocities of midpoint-type schemes carry a
-// step-to-step oscillation of fixed size, which a third difference reads as an error that no
-// step size reduces.
+// step-to-step oscillation of fixed size, which a divided difference reads as an error that no
+// step size reduces (and eem4's carry a constraint-normal part of size O(dt^2)).
 std::vector<int> testedDofs(const Layout& layout) {
   std::vector<int> dofs;
   for (int i = 0; i < layout.offset(Block::Multiplier); ++i)
@@ -46,7 +47,10 @@ class LocalError {
         rtol_(control.relativeTolerance),
         atolScale_(control.absoluteTolerance * model.dofScale()),
         tested_(testedDofs(model.layout())) {
-    for (Eigen::VectorXd& state : states_) state.resize(model.layout().total());
+    static_assert(LoopState::kMostErrorHistory >= 4 + 1, "the history holds order + 1 states of eem4");
+    if (order != 2 && order != 4) throw std::logic_error("LocalError knows the error constants of orders 2 and 4");
+    // slots beyond this order's history stay zero (a checkpoint writes every slot)
+    for (Eigen::VectorXd& state : states_) state.setZero(model.layout().total());
   }
 
   // The step factor for an error norm: (safety / err)^(1/(p + 1)), unlimited.
@@ -76,7 +80,8 @@ class LocalError {
     count_ = saved.errorHistoryCount;
     times_ = saved.errorTimes;
     states_ = saved.errorStates;
-    for (Eigen::VectorXd& state : states_) state.resize(atolScale_.size());
+    for (Eigen::VectorXd& state : states_)
+      if (state.size() != atolScale_.size()) state.setZero(atolScale_.size());
   }
   // True when p + 1 states of this stretch are known, so that ofStep applies.
   bool hasHistory() const { return count_ == history_; }

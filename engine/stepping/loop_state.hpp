@@ -30,7 +30,7 @@ struct LoopState {
   Eigen::VectorXd predictorStart, predictorEnd;
   double predictorTime = 0.0, predictorDt = 0.0;
   // adaptive steps: the next step to try, and the accepted states the error estimate uses
-  // (order + 1 of them; the first errorHistoryCount are set)
+  // (the first order + 1 slots, oldest first; of these, the last errorHistoryCount are set)
   static constexpr int kMostErrorHistory = 5;
   double proposedStep = 0.0;
   int errorHistoryCount = 0;

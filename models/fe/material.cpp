@@ -9,9 +9,6 @@ namespace mpx {
 
 namespace {
 
-// Green-Lagrange strain E = (C - I)/2.
-Mat3 greenStrain(const Mat3& C) { return 0.5 * (C - Mat3::Identity()); }
-
 // The isotropic quadratic energy lambda/2 tr(A)^2 + mu A:A of a strain A, shared by St Venant-Kirchhoff and the
 // Maxwell branch.
 double quadraticEnergy(const LameParameters& lame, const Mat3& A) {

@@ -8,6 +8,9 @@ namespace mpx {
 
 using Mat3 = Eigen::Matrix3d;
 
+// Green-Lagrange strain E = (C - I)/2.
+inline Mat3 greenStrain(const Mat3& C) { return 0.5 * (C - Mat3::Identity()); }
+
 // Lame constants from Young's modulus and Poisson's ratio; throws std::invalid_argument unless E > 0 and
 // -1 < nu < 0.5 (the message says which).
 struct LameParameters {

@@ -1,5 +1,6 @@
 #include "models/fe/solid_element.hpp"
 
+#include "models/fe/cell_tensors.hpp"
 #include "models/fe/discrete_stress.hpp"
 
 #include "engine/core/discrete_gradient.hpp"
@@ -10,10 +11,11 @@
 
 namespace mpx {
 
-namespace {
-// Symmetric tensor components of a viscous strain, in the order of its dofs.
-constexpr int kComponent[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+using cell::branchStressOf;
+using cell::contract;
+using cell::kComponent;
 
+namespace {
 std::vector<int> collectDofs(const SolidElementSpec& spec) {
   std::vector<int> dofs;
   for (int shift : {0, spec.velocityShift})
@@ -26,12 +28,6 @@ std::vector<int> collectDofs(const SolidElementSpec& spec) {
   return dofs;
 }
 
-// The branch stress of a strain A: lambda_v tr(A) I + 2 mu_v A (linear in A).
-Mat3 branchStressOf(const ViscousBranch& branch, const Mat3& strain) {
-  return branch.moduli.lambda * strain.trace() * Mat3::Identity() + 2 * branch.moduli.mu * strain;
-}
-
-double contract(const Mat3& a, const Mat3& b) { return (a.array() * b.array()).sum(); }
 }  // namespace
 
 // A quadrature point as one scheme sees it. EEM: forces at F_m with the discrete stress,

@@ -8,17 +8,18 @@
 // so that the Gauss sums of the stress power are the energies' changes. The nodal forces are
 // w F_l (S~_l + D Psi_l) dN_a/dX at each stage (moments vanish: the stresses are symmetric), and
 // the viscous strain follows Gamma' = D Psi_l / eta there, dissipating D Psi_l : D Psi_l / eta.
+#include "models/fe/cell_tensors.hpp"
 #include "models/fe/solid_element.hpp"
 
 #include "engine/core/stage_gradient.hpp"
 
 namespace mpx {
 
-namespace {
-// Symmetric tensor components of a viscous strain, in the order of its dofs.
-constexpr int kComponent[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+using cell::branchStressOf;
+using cell::contract;
+using cell::kComponent;
 
-double contract(const Mat3& a, const Mat3& b) { return (a.array() * b.array()).sum(); }
+namespace {
 // The change of C = F^T F for a change dF of F.
 Mat3 strainChange(const Mat3& F, const Mat3& dF) { return dF.transpose() * F + F.transpose() * dF; }
 
@@ -29,9 +30,8 @@ struct Correction {
   double coefficient, norm, normSlope;
 };
 Correction correction(double defect, double norm) {
-  const double floorRatio = kStagePathFloor / (norm + kStagePathFloor);
-  const double floored = norm + kStagePathFloor * floorRatio;
-  return {defect / floored, floored, 1.0 - floorRatio * floorRatio};
+  const FlooredNorm floored = flooredNorm(norm);
+  return {defect / floored.value, floored.value, floored.slope};
 }
 }  // namespace
 
@@ -81,22 +81,19 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
     Mat3 branchGradient = Mat3::Zero();
     const int gammaRow = 6 * nodes_ + 6 * q;
     if (spec_.branch) {
-      auto strainAt = [&](const Mat3& c) -> Mat3 { return 0.5 * (c - Mat3::Identity()); };
-      auto branchStress = [&](const Mat3& a) -> Mat3 {
-        return spec_.branch->moduli.lambda * a.trace() * Mat3::Identity() + 2.0 * spec_.branch->moduli.mu * a;
-      };
+      auto branchStress = [&](const Mat3& a) { return branchStressOf(*spec_.branch, a); };
       Mat3 gamma[kStages + 1];
       gamma[0] = viscousStrain(args.zOld, q);
       for (int j = 0; j < s; ++j) gamma[j + 1] = viscousStrain(args.stageState[j], q);
-      const Mat3 A0 = strainAt(C0) - gamma[0];
-      AEnd = strainAt(CEnd) - viscousStrain(args.zEnd, q);
+      const Mat3 A0 = greenStrain(C0) - gamma[0];
+      AEnd = greenStrain(CEnd) - viscousStrain(args.zEnd, q);
       branchEnd = branchStress(AEnd);
       // Psi_v is quadratic in A: its change is exact from the mean stress
       double branchDefect = 0.5 * contract(AEnd - A0, branchStress(AEnd + A0)), branchNorm = 0.0;
       for (int j = 0; j < s; ++j) {
         Mat3 gammaRate = Mat3::Zero();
         for (int i = 0; i <= s; ++i) gammaRate += rule.rate[j][i] * gamma[i];
-        A[j] = strainAt(C[j]) - gamma[j + 1];
+        A[j] = greenStrain(C[j]) - gamma[j + 1];
         ARate[j] = 0.5 * strainRate[j] - gammaRate;
         branch[j] = branchStress(A[j]);
         branchDefect -= rule.weight[j] * contract(branch[j], ARate[j]);
@@ -144,8 +141,7 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
         double dBranchPower = contract(branch[j], dARate);
         if (j == column) {
           const Mat3 dA = 0.5 * strainChange(F[j], dF) - dGamma;
-          dBranchPower += contract(dA, spec_.branch->moduli.lambda * ARate[j].trace() * Mat3::Identity() +
-                                           2.0 * spec_.branch->moduli.mu * ARate[j]);
+          dBranchPower += contract(dA, branchStressOf(*spec_.branch, ARate[j]));
         }
         dBranchDefect -= rule.weight[j] * dBranchPower;
         dBranchNorm += 2.0 * rule.weight[j] * contract(ARate[j], dARate);
@@ -159,7 +155,7 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
         Mat3 dBranch = dNu * ARate[l] + viscous.coefficient * dARateOwn;
         if (own) {
           const Mat3 dA = 0.5 * strainChange(F[l], dF) - dGamma;
-          dBranch += spec_.branch->moduli.lambda * dA.trace() * Mat3::Identity() + 2.0 * spec_.branch->moduli.mu * dA;
+          dBranch += branchStressOf(*spec_.branch, dA);
         }
         dStress += dBranch;
         const double fluidity = 1.0 / spec_.branch->viscosity;

@@ -139,13 +139,13 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
       const double phi = form.value(q), test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
       const ConstraintVector gradient = form.gradientAt(q);
-      const double value = multiplier + spec_.stiffness * phi, dq = rule.fineValue[p][column + 1];
+      const double value = multiplier + spec_.stiffness * phi, valueCoefficient = rule.fineValue[p][column + 1];
       force += (test * value) * gradient;
-      dForce += (test * dq) * (value * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+      dForce += (test * valueCoefficient) * (value * form.hessian + spec_.stiffness * gradient * gradient.transpose());
       if (!held) continue;
       dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
       rateOfPhi += test * gradient.dot(rate);
-      rateRow += test * (dq * form.hessian * rate + rule.fineRate[p][column + 1] * gradient);
+      rateRow += test * (valueCoefficient * form.hessian * rate + rule.fineRate[p][column + 1] * gradient);
     }
     r.segment(n, n) += force;
     K.block(n, 0, n, n) += dForce;
