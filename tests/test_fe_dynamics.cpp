@@ -585,11 +585,15 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
   const Model& model = *scene.model;
   const Layout& layout = model.layout();
   const VectorXd zOld = model.initialState() + 1e-2 * randomIsh(magnitudeAt(model, model.initialState()), 17);
-  const VectorXd zNew = zOld + 1e-2 * randomIsh(magnitudeAt(model, zOld), 19);
-  const VectorXd weight = magnitudeAt(model, zNew).cwiseInverse();
-  for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint}) {
+  for (Scheme scheme : {Scheme::Eem, Scheme::Midpoint, Scheme::Eem4}) {
     Integrator integrator(model, scheme, scene.settings.newton);
-    const Assembler& system = integrator.evaluate(zOld, zNew, 2.0, 0.1);
+    // the Newton unknowns: the end state, or eem4's stage values (its stage system is condensed
+    // stage by stage)
+    const int stages = integrator.stageCount();
+    const VectorXd scale = magnitudeAt(model, zOld).replicate(stages, 1);
+    const VectorXd unknowns = zOld.replicate(stages, 1) + 1e-2 * randomIsh(scale, 19);
+    const VectorXd weight = (unknowns.cwiseAbs() + model.dofScale().replicate(stages, 1)).cwiseInverse();
+    const Assembler& system = integrator.evaluate(zOld, unknowns, 2.0, 0.1);
     Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
     lu.compute(system.tangent());
     ASSERT_EQ(lu.info(), Eigen::Success) << lu.lastErrorMessage();
@@ -597,19 +601,21 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
 
     CondensedSolver condensed(layout, system.tangent());
     ASSERT_TRUE(condensed.factorize(system.tangent(), false));
-    VectorXd increment(layout.total());
+    VectorXd increment(unknowns.size());
     condensed.solve(system.residual(), increment);
     // every dof weighed by its magnitude, so that positions and velocities compare alike
     const double difference = (increment - plain).cwiseProduct(weight).cwiseAbs().maxCoeff() /
                               plain.cwiseProduct(weight).cwiseAbs().maxCoeff();
     const VectorXd defect = system.tangent() * increment + system.residual();
     const double backwardError =
-        defect.norm() / (system.residual().norm() + MatrixXd(system.tangent()).norm() * increment.norm());
+        defect.norm() / (system.residual().norm() + system.tangent().norm() * increment.norm());
     std::printf("%s, %s: condensed %d of %d unknowns, backward error %.2e, relative difference to plain LU %.2e\n",
-                GetParam(), schemeName(scheme).c_str(), condensed.condensedSize(), layout.total(), backwardError,
-                difference);
-    // velocities and the internal variables (per quadrature point, per Maxwell element) eliminated
-    EXPECT_EQ(condensed.condensedSize(), layout.total() - layout.size(Block::Velocity) - layout.size(Block::Internal));
+                GetParam(), schemeName(scheme).c_str(), condensed.condensedSize(), static_cast<int>(unknowns.size()),
+                backwardError, difference);
+    // velocities eliminated at every stage, and in one-stage systems the internal variables
+    // (per quadrature point, per Maxwell element) as well
+    const int eliminatedInternal = stages == 1 ? layout.size(Block::Internal) : 0;
+    EXPECT_EQ(condensed.condensedSize(), stages * (layout.total() - layout.size(Block::Velocity)) - eliminatedInternal);
     EXPECT_LE(backwardError, 1e-14);
     EXPECT_LE(difference, 1e-8);
   }
