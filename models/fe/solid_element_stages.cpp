@@ -149,7 +149,8 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
       }
       const double dMu = (dDefect - elastic.coefficient * elastic.normSlope * dNorm) / elastic.norm;
       Mat3 dStress = 2.0 * dMu * strainRate[l] + 2.0 * elastic.coefficient * dStrainRateOwn;
-      if (own) dStress += spec_.material->stressIncrement(C[l], strainChange(F[l], dF));
+      // (a viscous-strain column leaves C, so the material increment is only taken for positions)
+      if (own && localColumn < momentumRow) dStress += spec_.material->stressIncrement(C[l], strainChange(F[l], dF));
       if (spec_.branch) {
         const double dNu = (dBranchDefect - viscous.coefficient * viscous.normSlope * dBranchNorm) / viscous.norm;
         Mat3 dBranch = dNu * ARate[l] + viscous.coefficient * dARateOwn;
