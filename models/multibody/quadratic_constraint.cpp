@@ -112,11 +112,20 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
   auto r = out.residual();
   auto K = out.tangent();
   const double* z = args.stageState[l];
-  // the basis points of the step's polynomial: the start, then each stage
+  // the basis points of the step's polynomial (the start, then each stage), and the positions
+  // and their tau-rates at the points of the fine rule, which every form shares
   ConstraintVector basis[CollocationRule::kMostStages + 1];
   basis[0] = gather(args.zOld, 0);
   for (int j = 0; j < rule.stages; ++j) basis[j + 1] = gather(args.stageState[j], 0);
   const ConstraintVector qEnd = gather(args.zEnd, 0);
+  ConstraintVector fineQ[CollocationRule::kFinePoints], fineRate[CollocationRule::kFinePoints];
+  for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
+    fineQ[p] = fineRate[p] = ConstraintVector::Zero(n);
+    for (int j = 0; j <= rule.stages; ++j) {
+      fineQ[p] += rule.fineValue[p][j] * basis[j];
+      fineRate[p] += rule.fineRate[p][j] * basis[j];
+    }
+  }
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
     const bool held = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
@@ -130,11 +139,7 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     ConstraintMatrix dForce = ConstraintMatrix::Zero(n, n);
     double rateOfPhi = 0.0;
     for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
-      ConstraintVector q = ConstraintVector::Zero(n), rate = ConstraintVector::Zero(n);
-      for (int j = 0; j <= rule.stages; ++j) {
-        q += rule.fineValue[p][j] * basis[j];
-        rate += rule.fineRate[p][j] * basis[j];
-      }
+      const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
       const double phi = form.value(q), test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
