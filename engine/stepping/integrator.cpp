@@ -78,8 +78,10 @@ void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& s
   endOfStages(zOld, stages, stageEnd_);
   for (int l = 0; l < rule_.stages; ++l) {
     auto stageRate = stageRates_.segment(l * n, n);
-    stageRate = (rule_.rate[l][0] / dt) * zOld;
-    for (int j = 0; j < rule_.stages; ++j) stageRate += (rule_.rate[l][j + 1] / dt) * stages.segment(j * n, n);
+    // from the stages' increments over zOld (the rate coefficients sum to zero): a rate then
+    // carries the round-off of the increments, not of the values
+    stageRate.setZero();
+    for (int j = 0; j < rule_.stages; ++j) stageRate += (rule_.rate[l][j + 1] / dt) * (stages.segment(j * n, n) - zOld);
     state[l] = stages.data() + l * n;
     rate[l] = stageRates_.data() + l * n;
   }
@@ -101,8 +103,9 @@ bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eig
 
 void Integrator::endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const {
   const int n = static_cast<int>(zOld.size());
-  zEnd = rule_.end[0] * zOld;
-  for (int l = 0; l < rule_.stages; ++l) zEnd += rule_.end[l + 1] * stages.segment(l * n, n);
+  // as the rates, from the increments (the end coefficients sum to one)
+  zEnd = zOld;
+  for (int l = 0; l < rule_.stages; ++l) zEnd += rule_.end[l + 1] * (stages.segment(l * n, n) - zOld);
 }
 
 bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
