@@ -146,20 +146,12 @@ std::string caseName(const testing::TestParamInfo<StepLoopAllocation::ParamType>
   return scene + "_" + schemeName(std::get<1>(info.param));
 }
 
-INSTANTIATE_TEST_SUITE_P(BenchmarkScenes, StepLoopAllocation,
-                         testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
-                                                          "damped_double_pendulum.xml", "flexible_pendulum.xml",
-                                                          "cooled_flexible_pendulum.xml", "thermal_block.xml"),
-                                          testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal)),
-                         caseName);
-
-// The same for eem4 on the scenes it covers: lumped and thermal elements, joints with joint
-// forces and a reservoir, and a viscoelastic solid welded to a body.
-INSTANTIATE_TEST_SUITE_P(Eem4Scenes, StepLoopAllocation,
-                         testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml",
-                                                          "damped_double_pendulum.xml", "flexible_pendulum.xml"),
-                                          testing::Values(Scheme::Eem4)),
-                         caseName);
+INSTANTIATE_TEST_SUITE_P(
+    BenchmarkScenes, StepLoopAllocation,
+    testing::Combine(testing::Values("two_thermo_springs.xml", "thermo_visco_elastic.xml", "damped_double_pendulum.xml",
+                                     "flexible_pendulum.xml", "cooled_flexible_pendulum.xml", "thermal_block.xml"),
+                     testing::Values(Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal, Scheme::Eem4)),
+    caseName);
 
 // The counter sees allocations made inside the libraries: measuring into a fresh Measures
 // sizes its node temperatures (operator new in libstdc++), and a C allocation is counted.

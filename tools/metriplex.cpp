@@ -4,6 +4,7 @@
 #include "tools/output/history_plots.hpp"
 
 #include "engine/core/input_error.hpp"
+#include "engine/stepping/method.hpp"
 #include "engine/stepping/simulation.hpp"
 
 #include <fmt/format.h>
@@ -73,8 +74,9 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "run one scene with one integrator; writes DIR/history.csv");
   addSceneOptions(run, request);
   run->add_option("--integrator", request.integrator,
-                  "eem (the scene's thermal variable), eem-entropy, eem-temperature, midpoint, trapezoidal, ida "
-                  "(default: the scene's simulation integrator)");
+                  std::string(kMethodNames) +
+                      "; eem takes the scene's thermal variable (default: the scene's "
+                      "simulation integrator)");
   run->add_option("--dt", request.dt, "time step (default: the scene's simulation dt)");
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
   addToleranceOptions(run, request);

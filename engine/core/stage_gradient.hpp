@@ -11,6 +11,8 @@
 #include "engine/core/component.hpp"
 #include "engine/core/discrete_gradient.hpp"
 
+#include <cmath>
+
 namespace mpx {
 
 // A gradient over the arguments and the derivative of each entry over a component's local dofs.
@@ -90,6 +92,67 @@ GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, c
   out.grad += mu * direction;
   for (int i = 0; i < 3; ++i) out.d[i] += direction[i] * dMu + (mu * metric[i]) * path.rateRows[stage][i];
   return out;
+}
+
+}  // namespace mpx
+
+namespace mpx {
+
+// The stage gradient D psi_l of a function of one dof along that dof's stage polynomial (the
+// formula above for one argument), and its derivative with respect to the dof's value at stage
+// args.column.
+struct ScalarStageGradient {
+  double value = 0.0;
+  double slope = 0.0;
+};
+
+// psi(x) as its value and first two derivatives.
+struct ScalarJet {
+  double value, slope, curvature;
+};
+
+// psiJet(x) returns psi at x as a ScalarJet, psiChange(x0, x1) psi(x1) - psi(x0) without
+// cancellation (mu divides the defect's round-off by the rates' norm); `scale` is the dof's
+// scale in the floor of that norm.
+template <class Jet1, class Change>
+ScalarStageGradient scalarStageGradient(const Jet1& psiJet, const Change& psiChange, double scale,
+                                        const StageArgs& args, int dof) {
+  const CollocationRule& rule = *args.rule;
+  const int s = rule.stages, l = args.stage, k = args.column;
+  const double metric = 1.0 / (scale * scale);
+  double rate[CollocationRule::kMostStages];
+  ScalarJet jet[CollocationRule::kMostStages];
+  double defect = psiChange(args.zOld[dof], args.zEnd[dof]), norm = 0.0;
+  for (int j = 0; j < s; ++j) {
+    rate[j] = args.dt * args.stageRate[j][dof];
+    jet[j] = psiJet(args.stageState[j][dof]);
+    defect -= rule.weight[j] * jet[j].slope * rate[j];
+    norm += rule.weight[j] * metric * rate[j] * rate[j];
+  }
+  // derivatives in the column stage's value: x_j moves on its own stage, x'_j by rate[j][k + 1]
+  double dDefect = rule.end[k + 1] * psiJet(args.zEnd[dof]).slope, dNorm = 0.0;
+  for (int j = 0; j < s; ++j) {
+    if (j == k) dDefect -= rule.weight[j] * jet[j].curvature * rate[j];
+    dDefect -= rule.weight[j] * jet[j].slope * rule.rate[j][k + 1];
+    dNorm += 2.0 * rule.weight[j] * metric * rate[j] * rule.rate[j][k + 1];
+  }
+  const FlooredNorm floored = flooredNorm(norm);
+  const double mu = defect / floored.value;
+  const double dMu = (dDefect - mu * floored.slope * dNorm) / floored.value;
+  return {jet[l].slope + mu * metric * rate[l],
+          (l == k ? jet[l].curvature : 0.0) + dMu * metric * rate[l] + mu * metric * rule.rate[l][k + 1]};
+}
+
+// The temperature the heat rows of a dof holding a temperature theta are weighted with at stage
+// args.stage: T_l = 1 / D(ln theta)_l, so that sum_l b_l theta'_l / T_l = ln theta(1) - ln theta(0)
+// (the stage form of the logarithmic mean). The floor's scale is the step's start temperature.
+// A non-positive value (no admissible temperature) is returned as it is: callers reject it.
+inline ScalarStageGradient stageTemperature(const StageArgs& args, int dof) {
+  auto logarithm = [](double theta) { return ScalarJet{std::log(theta), 1.0 / theta, -1.0 / (theta * theta)}; };
+  auto logarithmChange = [](double theta0, double theta1) { return std::log1p((theta1 - theta0) / theta0); };
+  const ScalarStageGradient inverse = scalarStageGradient(logarithm, logarithmChange, args.zOld[dof], args, dof);
+  const double T = 1.0 / inverse.value;
+  return {T, -T * T * inverse.slope};
 }
 
 }  // namespace mpx

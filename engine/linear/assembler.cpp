@@ -3,6 +3,7 @@
 #include "engine/linear/sparse_entry.hpp"
 
 #include "engine/core/discrete_gradient.hpp"
+#include "engine/core/stage_gradient.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -162,7 +163,12 @@ void Assembler::imposeStageMotions(const Model& model, const StageArgs& args) {
       const double value = p.kind == PrescribedKind::Displacement
                                ? z[p.dof] - p.amplitude * p.profile.slope(t)
                                : z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
-      replaceRow(k, p, value, 1.0, z[p.dof], l, args.rule->weight[l]);
+      // heat through a prescribed temperature enters at the stage temperature its cells use
+      StageArgs atStage = args;
+      atStage.stage = atStage.column = l;
+      const double conjugate =
+          p.kind == PrescribedKind::Temperature ? stageTemperature(atStage, p.dof).value : z[p.dof];
+      replaceRow(k, p, value, 1.0, conjugate, l, args.rule->weight[l]);
     }
   }
 }

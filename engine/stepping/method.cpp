@@ -34,12 +34,8 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
   if (method.scheme == Scheme::Eem4)
     for (const auto& component : model.components())
       if (component->stageForm() == Component::StageForm::None)
-        throw InputError(
-            scene + ": integrator '" + method.name + "' has no fourth-order form for element '" + component->name() +
-            "' yet (eem4 covers masses, rigid bodies, their joints and joint forces, springs, "
-            "thermo-springs, Maxwell elements, dampers, heat links, reservoirs, fixed temperatures, forces, "
-            "torques, actuators and hyperelastic and viscoelastic solids, but not thermal solids; "
-            "docs/theory.md section 13)");
+        throw InputError(scene + ": integrator '" + method.name + "' has no fourth-order form for element '" +
+                         component->name() + "' (docs/theory.md section 13)");
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.kind == PrescribedKind::Displacement)

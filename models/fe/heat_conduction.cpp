@@ -55,4 +55,14 @@ void HeatConduction::rateLocal(const RateArgs& args, Workspace&, LocalSystem& ou
   assemble(T, slope, out);
 }
 
+void HeatConduction::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  ShapeValues T = ShapeValues::Zero(), slope = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) {
+    const TemperatureJet jet = thermalVariable_.stage(args, dofs()[a]).temperature;
+    T[a] = jet.value;
+    slope[a] = jet.slope;
+  }
+  assemble(T, slope, out);
+}
+
 }  // namespace mpx

@@ -1,6 +1,7 @@
 #include "models/fe/nodal_thermal_variable.hpp"
 
 #include "engine/core/discrete_gradient.hpp"
+#include "engine/core/stage_gradient.hpp"
 
 #include <cmath>
 
@@ -45,6 +46,25 @@ TemperatureJet NodalThermalVariable::step(double sOld, double sNew) const {
 TemperatureJet NodalThermalVariable::rate(double s, double alpha) const {
   const double theta = temperature(s);
   return {theta, alpha * (kind_ == ThermalVariable::Temperature ? 1.0 : theta / capacity_)};
+}
+
+// The temperature form's energy is linear (D_theta e = kappa) and its temperature 1 / D(ln theta);
+// the entropy form's entropy is linear (D_s eta = 1) and its temperature D_s e.
+NodalThermalVariable::Stage NodalThermalVariable::stage(const StageArgs& args, int dof) const {
+  const CollocationRule& rule = *args.rule;
+  const double rate = args.stageRate[args.stage][dof];
+  const double rateSlope = rule.rate[args.stage][args.column + 1] / args.dt;
+  if (kind_ == ThermalVariable::Temperature) {
+    const ScalarStageGradient T = stageTemperature(args, dof);
+    return {{T.value, T.slope}, {capacity_ * rate, capacity_ * rateSlope}};
+  }
+  auto energyJet = [&](double s) { return ScalarJet{energy(s), energySlope(s), energyCurvature(s)}; };
+  // e(s1) - e(s0) = kappa theta_R exp(s0/kappa) expm1((s1 - s0)/kappa)
+  auto energyChange = [&](double s0, double s1) {
+    return capacity_ * referenceTemperature_ * std::exp(s0 / capacity_) * std::expm1((s1 - s0) / capacity_);
+  };
+  const ScalarStageGradient T = scalarStageGradient(energyJet, energyChange, capacity_, args, dof);
+  return {{T.value, T.slope}, {T.value * rate, T.slope * rate + T.value * rateSlope}};
 }
 
 double NodalThermalVariable::scale() const {

@@ -36,6 +36,14 @@ class NodalThermalVariable {
   TemperatureJet step(double sOld, double sNew) const;
   // theta(s) and alpha dtheta/ds, for a rate evaluation with tangent coefficient alpha.
   TemperatureJet rate(double s, double alpha) const;
+  // An eem4 stage of the node's dof: the stage temperature D_s e / D_s eta along the dof's stage
+  // polynomial (docs/theory.md section 13.9) and the capacity's energy rate D_s e s' (per unit
+  // volume), with their derivatives in the dof's value at stage args.column.
+  struct Stage {
+    TemperatureJet temperature;
+    TemperatureJet energyRate;
+  };
+  Stage stage(const StageArgs& args, int dof) const;
   // Newton's scale of the dof.
   double scale() const;
 

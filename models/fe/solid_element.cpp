@@ -93,15 +93,21 @@ ShapeValues SolidElement::nodeTemperatures(const double* z) const {
   return theta;
 }
 
-// eta(theta) = eta_R exp(-a (theta - theta_R)) at the point's temperature (constant without a
+// eta(theta) = eta_R exp(-a (theta - theta_R)) at a point's temperature (constant without a
 // thermal field)
-void SolidElement::setFluidity(PointEvaluation& e) const {
-  if (!spec_.branch) return;
-  e.fluidity = 1.0 / spec_.branch->viscosity;
-  if (!spec_.thermal) return;
+SolidElement::Fluidity SolidElement::fluidityAt(double temperature) const {
+  if (!spec_.branch) return {};
+  const double fluidity = 1.0 / spec_.branch->viscosity;
+  if (!spec_.thermal) return {fluidity, 0.0};
   const double activation = spec_.thermal->viscosityActivation;
-  e.fluidity *= std::exp(activation * (e.temperature - spec_.thermal->referenceTemperature));
-  e.fluiditySlope = activation * e.fluidity;
+  const double value = fluidity * std::exp(activation * (temperature - spec_.thermal->referenceTemperature));
+  return {value, activation * value};
+}
+
+void SolidElement::setFluidity(PointEvaluation& e) const {
+  const Fluidity f = fluidityAt(e.temperature);
+  e.fluidity = f.value;
+  e.fluiditySlope = f.slope;
 }
 
 double SolidElement::pointTemperature(int q, const NodeTemperatures& nodes) const {
@@ -146,7 +152,7 @@ void SolidElement::measure(const double* z, Measures& out) const {
 // A cell turned inside out (det F <= 0) is no admissible state, although C = F^T F, and with it
 // every energy, looks regular there: a non-finite residual makes Newton backtrack or the step
 // fail, instead of the run going on in a mirrored configuration.
-void SolidElement::rejectInverted(LocalSystem& out) { out.r[0] = std::numeric_limits<double>::quiet_NaN(); }
+void SolidElement::rejectInadmissible(LocalSystem& out) { out.r[0] = std::numeric_limits<double>::quiet_NaN(); }
 
 template <class MaterialIncrement>
 void SolidElement::assemblePoint(int q, const PointEvaluation& e, const MaterialIncrement& materialIncrement,
@@ -258,7 +264,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const ShapeGradients& G = spec_.points[q].gradients;
     const Mat3 F0 = x0 * G, F1 = x1 * G;
-    if (!(F1.determinant() > 0.0)) return rejectInverted(out);
+    if (!(F1.determinant() > 0.0)) return rejectInadmissible(out);
     const Mat3 C0 = F0.transpose() * F0, C1 = F1.transpose() * F1;
     const DiscreteStress discrete(*spec_.material, C0, C1);
     PointEvaluation e{0.5 * (F0 + F1), 0.5, F1, discrete.stress()};
@@ -322,7 +328,7 @@ void SolidElement::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out,
     }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     const Mat3 F = x * spec_.points[q].gradients, C = F.transpose() * F;
-    if (!(F.determinant() > 0.0)) return rejectInverted(out);
+    if (!(F.determinant() > 0.0)) return rejectInadmissible(out);
     PointEvaluation e{F, 1.0, F, spec_.material->stress(C)};
     e.strainFactor = 0.5;
     e.gammaFactor = 1.0;

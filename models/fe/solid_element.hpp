@@ -62,9 +62,8 @@ class SolidElement final : public Component {
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
-  // eem4 (models/fe/solid_element_stages.cpp): hyperelastic and viscoelastic cells; thermal
-  // cells have no stage form yet
-  StageForm stageForm() const override;
+  // eem4 (models/fe/solid_element_stages.cpp)
+  StageForm stageForm() const override { return StageForm::Own; }
   void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
   // Cauchy stress and viscous strain averaged over the quadrature points (for output).
@@ -81,6 +80,11 @@ class SolidElement final : public Component {
   struct PointEvaluation;
   struct NodeTemperatures;
   double pointTemperature(int point, const NodeTemperatures& nodes) const;
+  // The branch's fluidity 1/eta at a temperature and its derivative in that temperature.
+  struct Fluidity {
+    double value = 0.0, slope = 0.0;
+  };
+  Fluidity fluidityAt(double temperature) const;
   void setFluidity(PointEvaluation& e) const;
   void addDissipation(int point, const PointEvaluation& e, Flows& flows) const;
   // The lumped heat capacity's rows m_a (rate of its energy per volume) with the rates' derivatives in
@@ -90,8 +94,9 @@ class SolidElement final : public Component {
   ShapeValues nodeTemperatures(const double* z) const;
   NodePositions positions(const double* z) const;
   Mat3 viscousStrain(const double* z, int point) const;
-  // Mark the evaluation of a state with an inverted cell as inadmissible.
-  static void rejectInverted(LocalSystem& out);
+  // Mark the evaluation of an inadmissible state (an inverted cell, a non-positive stage
+  // temperature) with a non-finite residual.
+  static void rejectInadmissible(LocalSystem& out);
   // Add the point's residual rows and tangent columns; materialIncrement(dC) is the change
   // of the hyperelastic (and coupling) stress for a change dC of the end point's C.
   template <class MaterialIncrement>

@@ -1,17 +1,24 @@
-// The eem4 stage form of a hyperelastic or viscoelastic solid cell (docs/theory.md section
-// 13.8). At each quadrature point each energy takes the energy-consistent stage gradient along
-// the stage polynomial: the stored energy W along C(tau) = F(tau)^T F(tau),
+// The eem4 stage form of a solid cell (docs/theory.md sections 13.8 and 13.9). At each
+// quadrature point each energy takes the energy-consistent stage gradient along the stage
+// polynomial: the stored energy W and a thermal cell's coupling entropy L = 3 beta K ln J along
+// C(tau) = F(tau)^T F(tau),
 //   S~_l = S(C_l) + 2 mu C'_l,  mu = [W(C_end) - W(C_0) - sum_j b_j S_j : C'_j / 2] / sum_j b_j C'_j : C'_j,
 // and the Maxwell branch's Psi_v along A(tau) = E(tau) - Gamma(tau),
 //   D Psi_l = S_v(A_l) + nu A'_l,  nu = [Psi_v(A_end) - Psi_v(A_0) - sum_j b_j S_v(A_j) : A'_j] / sum_j b_j A'_j :
 //   A'_j,
 // so that the Gauss sums of the stress power are the energies' changes. The nodal forces are
-// w F_l (S~_l + D Psi_l) dN_a/dX at each stage (moments vanish: the stresses are symmetric), and
+// w F_l (S~_l + D Psi_l + (theta_R - theta_l) S~L_l) dN_a/dX at each stage, with theta_l the
+// point's stage temperature sum_a N_a T_a,l (moments vanish: the stresses are symmetric), and
 // the viscous strain follows Gamma' = D Psi_l / eta there, dissipating D Psi_l : D Psi_l / eta.
+// A thermal node's heat row at stage l is T_a,l times its entropy balance, as in the EEM step
+// with the stage temperature T_a,l (models/fe/nodal_thermal_variable.hpp) for the logarithmic
+// mean and S~L_l : C'_l / 2 for the coupling entropy's change.
 #include "models/fe/cell_tensors.hpp"
 #include "models/fe/solid_element.hpp"
 
 #include "engine/core/stage_gradient.hpp"
+
+#include <optional>
 
 namespace mpx {
 
@@ -20,6 +27,9 @@ using cell::contract;
 using cell::kComponent;
 
 namespace {
+constexpr int kStages = CollocationRule::kMostStages;
+using CellPositions = Eigen::Matrix<double, 3, kMaxCellNodes>;
+
 // The change of C = F^T F for a change dF of F.
 Mat3 strainChange(const Mat3& F, const Mat3& dF) { return dF.transpose() * F + F.transpose() * dF; }
 
@@ -33,137 +43,249 @@ Correction correction(double defect, double norm) {
   const FlooredNorm floored = flooredNorm(norm);
   return {defect / floored.value, floored.value, floored.slope};
 }
-}  // namespace
 
-Component::StageForm SolidElement::stageForm() const { return spec_.thermal ? StageForm::None : StageForm::Own; }
+// One quadrature point's motion along the stage polynomial: F, its tau-rate F', C and
+// C' = F'^T F + F^T F' at each stage, C at the start and the end, and sum_j b_j C'_j : C'_j, the
+// norm every energy of C shares.
+struct PointPath {
+  Mat3 F[kStages], rate[kStages], C[kStages], strainRate[kStages];
+  Mat3 FEnd, C0, CEnd;
+  double norm = 0.0;
+};
+
+// (basis: the node positions at the start and at each stage; xRate: their tau-rates at each stage)
+PointPath pointPath(const CellPositions (&basis)[kStages + 1], const CellPositions (&xRate)[kStages],
+                    const CellPositions& xEnd, const ShapeGradients& G, const CollocationRule& rule) {
+  PointPath path;
+  for (int j = 0; j < rule.stages; ++j) {
+    path.F[j] = basis[j + 1] * G;
+    path.rate[j] = xRate[j] * G;
+    path.C[j] = path.F[j].transpose() * path.F[j];
+    path.strainRate[j] = strainChange(path.F[j], path.rate[j]);
+    path.norm += rule.weight[j] * contract(path.strainRate[j], path.strainRate[j]);
+  }
+  const Mat3 F0 = basis[0] * G;
+  path.FEnd = xEnd * G;
+  path.C0 = F0.transpose() * F0;
+  path.CEnd = path.FEnd.transpose() * path.FEnd;
+  return path;
+}
+
+// What a change dF of F at stage `column` (one position column) does to the path: each stage's
+// C', C at that stage and at the end (with its end coefficient), and the norm. All zero for a
+// column that leaves the positions.
+struct PathChange {
+  Mat3 strainRate[kStages] = {Mat3::Zero(), Mat3::Zero()};
+  Mat3 ownStrain = Mat3::Zero(), endStrain = Mat3::Zero();
+  double norm = 0.0;
+};
+
+PathChange pathChange(const PointPath& path, const CollocationRule& rule, int column, const Mat3& dF) {
+  PathChange change;
+  change.ownStrain = strainChange(path.F[column], dF);
+  change.endStrain = rule.end[column + 1] * strainChange(path.FEnd, dF);
+  for (int j = 0; j < rule.stages; ++j) {
+    change.strainRate[j] = strainChange(path.F[j], rule.rate[j][column + 1] * dF);
+    if (j == column) change.strainRate[j] += strainChange(path.rate[j], dF);
+    change.norm += 2.0 * rule.weight[j] * contract(path.strainRate[j], change.strainRate[j]);
+  }
+  return change;
+}
+
+// An energy of C along a point's path (W, or the coupling's L) and its stage gradient at stage l.
+class StrainEnergyPath {
+ public:
+  StrainEnergyPath(const HyperelasticMaterial& law, const PointPath& path, const CollocationRule& rule, int stage,
+                   int column)
+      : law_(law), path_(path), rule_(rule), stage_(stage), column_(column) {
+    double defect = law.energyDifference(path.C0, path.CEnd);
+    for (int j = 0; j < rule.stages; ++j) {
+      stress_[j] = law.stress(path.C[j]);
+      defect -= rule.weight[j] * 0.5 * contract(stress_[j], path.strainRate[j]);
+    }
+    stressEnd_ = law.stress(path.CEnd);
+    columnTangent_ = law.stressIncrement(path.C[column], path.strainRate[column]);
+    correction_ = correction(defect, path.norm);
+    gradient_ = stress_[stage] + 2.0 * correction_.coefficient * path.strainRate[stage];
+  }
+  const Mat3& gradient() const { return gradient_; }
+
+  // The change of S~_l: through mu (every stage's C', C_end and the column stage's stress) and,
+  // on the own stage, through S(C_l). In mu's derivative the material tangent enters only as
+  // dS(C_k)[C'_k] (its major symmetry: dS_k[dC_k] : C'_k = dC_k : dS_k[C'_k]).
+  Mat3 change(const PathChange& d) const {
+    double dDefect = 0.5 * contract(stressEnd_, d.endStrain);
+    for (int j = 0; j < rule_.stages; ++j) {
+      double dPower = contract(stress_[j], d.strainRate[j]);
+      if (j == column_) dPower += contract(d.ownStrain, columnTangent_);
+      dDefect -= rule_.weight[j] * 0.5 * dPower;
+    }
+    const double dMu = (dDefect - correction_.coefficient * correction_.normSlope * d.norm) / correction_.norm;
+    Mat3 dGradient = 2.0 * dMu * path_.strainRate[stage_] + 2.0 * correction_.coefficient * d.strainRate[stage_];
+    if (stage_ == column_) dGradient += law_.stressIncrement(path_.C[stage_], d.ownStrain);
+    return dGradient;
+  }
+
+ private:
+  const HyperelasticMaterial& law_;
+  const PointPath& path_;
+  const CollocationRule& rule_;
+  int stage_, column_;
+  Mat3 stress_[kStages], stressEnd_, columnTangent_, gradient_;
+  Correction correction_{};
+};
+
+// The Maxwell branch's energy along A = E - Gamma and its stage gradient D Psi_l at stage l.
+class BranchPath {
+ public:
+  // (gamma: the viscous strain at the start and at each stage; gammaRate: its tau-rates)
+  BranchPath(const ViscousBranch& branch, const PointPath& path, const Mat3 (&gamma)[kStages + 1],
+             const Mat3 (&gammaRate)[kStages], const Mat3& gammaEnd, const CollocationRule& rule, int stage, int column)
+      : branch_(branch), rule_(rule), stage_(stage), column_(column) {
+    const Mat3 A0 = greenStrain(path.C0) - gamma[0], AEnd = greenStrain(path.CEnd) - gammaEnd;
+    stressEnd_ = branchStressOf(branch, AEnd);
+    // Psi_v is quadratic in A: its change is exact from the mean stress
+    double defect = 0.5 * contract(AEnd - A0, branchStressOf(branch, AEnd + A0)), norm = 0.0;
+    for (int j = 0; j < rule.stages; ++j) {
+      A_[j] = greenStrain(path.C[j]) - gamma[j + 1];
+      rate_[j] = 0.5 * path.strainRate[j] - gammaRate[j];
+      stress_[j] = branchStressOf(branch, A_[j]);
+      defect -= rule.weight[j] * contract(stress_[j], rate_[j]);
+      norm += rule.weight[j] * contract(rate_[j], rate_[j]);
+    }
+    correction_ = correction(defect, norm);
+    gradient_ = stress_[stage] + correction_.coefficient * rate_[stage];
+  }
+  const Mat3& gradient() const { return gradient_; }
+
+  // The change of D Psi_l for a change d of the positions' path and dGamma of stage column's
+  // viscous strain (S_v is linear and symmetric: S_v(dA_j) : A'_j = dA_j : S_v(A'_j)).
+  Mat3 change(const PathChange& d, const Mat3& dGamma) const {
+    double dDefect = contract(stressEnd_, 0.5 * d.endStrain - rule_.end[column_ + 1] * dGamma), dNorm = 0.0;
+    Mat3 dRateOwn = Mat3::Zero();
+    const Mat3 dAOwn = 0.5 * d.ownStrain - dGamma;
+    for (int j = 0; j < rule_.stages; ++j) {
+      const Mat3 dRate = 0.5 * d.strainRate[j] - rule_.rate[j][column_ + 1] * dGamma;
+      double dPower = contract(stress_[j], dRate);
+      if (j == column_) dPower += contract(dAOwn, branchStressOf(branch_, rate_[j]));
+      dDefect -= rule_.weight[j] * dPower;
+      dNorm += 2.0 * rule_.weight[j] * contract(rate_[j], dRate);
+      if (j == stage_) dRateOwn = dRate;
+    }
+    const double dNu = (dDefect - correction_.coefficient * correction_.normSlope * dNorm) / correction_.norm;
+    Mat3 dGradient = dNu * rate_[stage_] + correction_.coefficient * dRateOwn;
+    if (stage_ == column_) dGradient += branchStressOf(branch_, dAOwn);
+    return dGradient;
+  }
+
+ private:
+  const ViscousBranch& branch_;
+  const CollocationRule& rule_;
+  int stage_, column_;
+  Mat3 A_[kStages], rate_[kStages], stress_[kStages], stressEnd_, gradient_;
+  Correction correction_{};
+};
+}  // namespace
 
 void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
   const CollocationRule& rule = *args.rule;
   const int l = args.stage, column = args.column, s = rule.stages, momentumRow = 3 * nodes_;
   const bool own = l == column;
-  constexpr int kStages = CollocationRule::kMostStages;
   // node positions at the basis points of the stage polynomial (the start, then each stage)
-  NodePositions basis[kStages + 1];
+  CellPositions basis[kStages + 1], xRate[kStages];
   basis[0] = positions(args.zOld);
-  for (int j = 0; j < s; ++j) basis[j + 1] = positions(args.stageState[j]);
-  const NodePositions xEnd = positions(args.zEnd);
+  for (int j = 0; j < s; ++j) {
+    basis[j + 1] = positions(args.stageState[j]);
+    xRate[j] = args.dt * positions(args.stageRate[j]);
+  }
+  const CellPositions xEnd = positions(args.zEnd);
+  // a thermal cell's nodes at the stage: T_a,l, the capacity's energy rate, their derivatives
+  NodalThermalVariable::Stage node[kMaxCellNodes];
+  if (spec_.thermal)
+    for (int a = 0; a < nodes_; ++a) {
+      node[a] = spec_.thermalVariable.stage(args, spec_.thermalDofs[a]);
+      if (!(node[a].temperature.value > 0.0)) return rejectInadmissible(out);
+    }
   auto r = out.residual();
   auto K = out.tangent();
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
-    const ShapeGradients& G = spec_.points[q].gradients;
-    const double w = spec_.points[q].weight;
-    // F, its tau-rate and C, C' at each stage; C at the start and the end
-    Mat3 F[kStages], rate[kStages], C[kStages], strainRate[kStages], stress[kStages];
-    for (int j = 0; j < s; ++j) {
-      F[j] = basis[j + 1] * G;
-      NodePositions xRate = NodePositions::Zero();
-      for (int i = 0; i <= s; ++i) xRate += rule.rate[j][i] * basis[i];
-      rate[j] = xRate * G;
-      C[j] = F[j].transpose() * F[j];
-      strainRate[j] = strainChange(F[j], rate[j]);
-      stress[j] = spec_.material->stress(C[j]);
-    }
-    const Mat3 F0 = basis[0] * G, FEnd = xEnd * G;
-    if (!(F[l].determinant() > 0.0) || !(FEnd.determinant() > 0.0)) return rejectInverted(out);
-    const Mat3 C0 = F0.transpose() * F0, CEnd = FEnd.transpose() * FEnd, stressEnd = spec_.material->stress(CEnd);
-    double defect = spec_.material->energyDifference(C0, CEnd), norm = 0.0;
-    for (int j = 0; j < s; ++j) {
-      defect -= rule.weight[j] * 0.5 * contract(stress[j], strainRate[j]);
-      norm += rule.weight[j] * contract(strainRate[j], strainRate[j]);
-    }
-    const Correction elastic = correction(defect, norm);
-    Mat3 totalStress = stress[l] + 2.0 * elastic.coefficient * strainRate[l];
-    const Mat3 columnTangent = spec_.material->stressIncrement(C[column], strainRate[column]);
+    const CellPoint& p = spec_.points[q];
+    const ShapeGradients& G = p.gradients;
+    const double w = p.weight;
+    const PointPath path = pointPath(basis, xRate, xEnd, G, rule);
+    if (!(path.F[l].determinant() > 0.0) || !(path.FEnd.determinant() > 0.0)) return rejectInadmissible(out);
+    const StrainEnergyPath elastic(*spec_.material, path, rule, l, column);
+    Mat3 totalStress = elastic.gradient();
 
-    // the branch: A = E - Gamma at each stage, its tau-rate, and its stage gradient D Psi_l
-    Mat3 A[kStages], ARate[kStages], branch[kStages], AEnd = Mat3::Zero(), branchEnd = Mat3::Zero();
-    Correction viscous{0.0, 1.0, 0.0};
-    Mat3 branchGradient = Mat3::Zero();
+    // a thermal point: its stage temperature and the coupling's stage gradient, whose power is
+    // the rate of the coupling entropy
+    std::optional<StrainEnergyPath> coupling;
+    double temperature = 0.0, shift = 0.0, entropyRate = 0.0;
+    ShapeValues temperatureSlope = ShapeValues::Zero();
+    if (spec_.thermal) {
+      coupling.emplace(*coupling_, path, rule, l, column);
+      for (int a = 0; a < nodes_; ++a) {
+        temperature += p.values[a] * node[a].temperature.value;
+        temperatureSlope[a] = p.values[a] * node[a].temperature.slope;
+      }
+      shift = spec_.thermal->referenceTemperature - temperature;
+      totalStress += shift * coupling->gradient();
+      entropyRate = 0.5 * contract(coupling->gradient(), path.strainRate[l]) / args.dt;
+    }
+
+    // the branch: Gamma' = D Psi_l / eta at the stage; its dissipation leaves a mechanical cell
+    // and heats a thermal cell's nodes
+    std::optional<BranchPath> branch;
+    const Fluidity fluidity = fluidityAt(temperature);
+    double heating = 0.0;
     const int gammaRow = 6 * nodes_ + 6 * q;
     if (spec_.branch) {
-      auto branchStress = [&](const Mat3& a) { return branchStressOf(*spec_.branch, a); };
-      Mat3 gamma[kStages + 1];
+      Mat3 gamma[kStages + 1], gammaRate[kStages];
       gamma[0] = viscousStrain(args.zOld, q);
-      for (int j = 0; j < s; ++j) gamma[j + 1] = viscousStrain(args.stageState[j], q);
-      const Mat3 A0 = greenStrain(C0) - gamma[0];
-      AEnd = greenStrain(CEnd) - viscousStrain(args.zEnd, q);
-      branchEnd = branchStress(AEnd);
-      // Psi_v is quadratic in A: its change is exact from the mean stress
-      double branchDefect = 0.5 * contract(AEnd - A0, branchStress(AEnd + A0)), branchNorm = 0.0;
       for (int j = 0; j < s; ++j) {
-        Mat3 gammaRate = Mat3::Zero();
-        for (int i = 0; i <= s; ++i) gammaRate += rule.rate[j][i] * gamma[i];
-        A[j] = greenStrain(C[j]) - gamma[j + 1];
-        ARate[j] = 0.5 * strainRate[j] - gammaRate;
-        branch[j] = branchStress(A[j]);
-        branchDefect -= rule.weight[j] * contract(branch[j], ARate[j]);
-        branchNorm += rule.weight[j] * contract(ARate[j], ARate[j]);
+        gamma[j + 1] = viscousStrain(args.stageState[j], q);
+        gammaRate[j] = args.dt * viscousStrain(args.stageRate[j], q);
       }
-      viscous = correction(branchDefect, branchNorm);
-      branchGradient = branch[l] + viscous.coefficient * ARate[l];
-      totalStress += branchGradient;
-      // Gamma' = D Psi_l / eta at the stage
-      const double fluidity = 1.0 / spec_.branch->viscosity;
+      branch.emplace(*spec_.branch, path, gamma, gammaRate, viscousStrain(args.zEnd, q), rule, l, column);
+      totalStress += branch->gradient();
       for (int k = 0; k < 6; ++k) {
         const auto [i, j] = kComponent[k];
-        r[gammaRow + k] = args.stageRate[l][spec_.firstInternalDof + 6 * q + k] - fluidity * branchGradient(i, j);
+        r[gammaRow + k] =
+            args.stageRate[l][spec_.firstInternalDof + 6 * q + k] - fluidity.value * branch->gradient()(i, j);
       }
-      flows.dissipated += w * fluidity * contract(branchGradient, branchGradient);
+      heating = w * fluidity.value * contract(branch->gradient(), branch->gradient());
+      if (!spec_.thermal) flows.dissipated += heating;
     }
 
-    // nodal forces w F_l (S~_l + D Psi_l) dN_a/dX
-    const Mat3 firstPiola = w * F[l] * totalStress;
+    // nodal forces w F_l (S~_l + D Psi_l + shift S~L_l) dN_a/dX; heat rows T_a,l w N_a L' - N_a heating
+    const Mat3 firstPiola = w * path.F[l] * totalStress;
     for (int a = 0; a < nodes_; ++a) r.segment<3>(momentumRow + 3 * a) += firstPiola * G.row(a).transpose();
+    if (spec_.thermal)
+      for (int a = 0; a < nodes_; ++a)
+        r[firstThermal_ + a] += node[a].temperature.value * w * p.values[a] * entropyRate - p.values[a] * heating;
 
-    // A column of stage `column`: its positions move F by dF, its viscous strain by dGamma.
-    // The stresses change through F_l and S(C_l), A_l on the own stage, and through the
-    // corrections and the rates, which see every stage.
-    auto addColumn = [&](int localColumn, const Mat3& dF, const Mat3& dGamma) {
-      double dDefect = rule.end[column + 1] * 0.5 * contract(stressEnd, strainChange(FEnd, dF)), dNorm = 0.0;
-      Mat3 dStrainRateOwn = Mat3::Zero();
-      double dBranchDefect = 0.0, dBranchNorm = 0.0;
-      Mat3 dARateOwn = Mat3::Zero();
-      if (spec_.branch)
-        dBranchDefect = rule.end[column + 1] * contract(branchEnd, 0.5 * strainChange(FEnd, dF) - dGamma);
-      for (int j = 0; j < s; ++j) {
-        // C'_j = F'_j^T F_j + F_j^T F'_j: F'_j moves with rule.rate, F_j on its own stage
-        Mat3 dStrainRate = strainChange(F[j], rule.rate[j][column + 1] * dF);
-        if (j == column) dStrainRate += strainChange(rate[j], dF);
-        // dS_j[dC_j] : C'_j = dC_j : dS_j[C'_j] (the tangent's major symmetry)
-        double dPower = contract(stress[j], dStrainRate);
-        if (j == column) dPower += contract(strainChange(F[j], dF), columnTangent);
-        dDefect -= rule.weight[j] * 0.5 * dPower;
-        dNorm += 2.0 * rule.weight[j] * contract(strainRate[j], dStrainRate);
-        if (j == l) dStrainRateOwn = dStrainRate;
-        if (!spec_.branch) continue;
-        const Mat3 dARate = 0.5 * dStrainRate - rule.rate[j][column + 1] * dGamma;
-        // S_v is linear and symmetric: S_v(dA_j) : A'_j = dA_j : S_v(A'_j)
-        double dBranchPower = contract(branch[j], dARate);
-        if (j == column) {
-          const Mat3 dA = 0.5 * strainChange(F[j], dF) - dGamma;
-          dBranchPower += contract(dA, branchStressOf(*spec_.branch, ARate[j]));
-        }
-        dBranchDefect -= rule.weight[j] * dBranchPower;
-        dBranchNorm += 2.0 * rule.weight[j] * contract(ARate[j], dARate);
-        if (j == l) dARateOwn = dARate;
-      }
-      const double dMu = (dDefect - elastic.coefficient * elastic.normSlope * dNorm) / elastic.norm;
-      Mat3 dStress = 2.0 * dMu * strainRate[l] + 2.0 * elastic.coefficient * dStrainRateOwn;
-      // (a viscous-strain column leaves C, so the material increment is only taken for positions)
-      if (own && localColumn < momentumRow) dStress += spec_.material->stressIncrement(C[l], strainChange(F[l], dF));
-      if (spec_.branch) {
-        const double dNu = (dBranchDefect - viscous.coefficient * viscous.normSlope * dBranchNorm) / viscous.norm;
-        Mat3 dBranch = dNu * ARate[l] + viscous.coefficient * dARateOwn;
-        if (own) {
-          const Mat3 dA = 0.5 * strainChange(F[l], dF) - dGamma;
-          dBranch += branchStressOf(*spec_.branch, dA);
-        }
+    // A position or viscous-strain column of stage `column`: the positions move F by dF (the
+    // path by d), the viscous strain by dGamma.
+    auto addColumn = [&](int localColumn, const Mat3& dF, const PathChange& d, const Mat3& dGamma, bool moves) {
+      Mat3 dStress = moves ? elastic.change(d) : Mat3::Zero();
+      Mat3 dBranch = Mat3::Zero();
+      if (branch) {
+        dBranch = branch->change(d, dGamma);
         dStress += dBranch;
-        const double fluidity = 1.0 / spec_.branch->viscosity;
         for (int k = 0; k < 6; ++k)
-          K(gammaRow + k, localColumn) -= fluidity * dBranch(kComponent[k][0], kComponent[k][1]);
+          K(gammaRow + k, localColumn) -= fluidity.value * dBranch(kComponent[k][0], kComponent[k][1]);
       }
-      Mat3 dPiola = w * F[l] * dStress;
+      if (coupling) {
+        const Mat3 dCoupling = moves ? coupling->change(d) : Mat3::Zero();
+        dStress += shift * dCoupling;
+        const double dEntropyRate =
+            0.5 * (contract(dCoupling, path.strainRate[l]) + contract(coupling->gradient(), d.strainRate[l])) / args.dt;
+        const double dHeating = branch ? 2.0 * w * fluidity.value * contract(branch->gradient(), dBranch) : 0.0;
+        for (int a = 0; a < nodes_; ++a)
+          K(firstThermal_ + a, localColumn) +=
+              node[a].temperature.value * w * p.values[a] * dEntropyRate - p.values[a] * dHeating;
+      }
+      Mat3 dPiola = w * path.F[l] * dStress;
       if (own) dPiola += w * dF * totalStress;
       for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, localColumn) += dPiola * G.row(a).transpose();
     };
@@ -171,17 +293,43 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
       for (int i = 0; i < 3; ++i) {
         Mat3 dF = Mat3::Zero();
         dF.row(i) = G.row(b);
-        addColumn(3 * b + i, dF, Mat3::Zero());
+        addColumn(3 * b + i, dF, pathChange(path, rule, column, dF), Mat3::Zero(), true);
       }
-    if (!spec_.branch) continue;
-    for (int m = 0; m < 6; ++m) {
-      Mat3 dGamma = Mat3::Zero();
-      dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
-      addColumn(gammaRow + m, Mat3::Zero(), dGamma);
-      // the viscous strain's own rate
-      K(gammaRow + m, gammaRow + m) += rule.rate[l][column + 1] / args.dt;
+    if (branch)
+      for (int m = 0; m < 6; ++m) {
+        Mat3 dGamma = Mat3::Zero();
+        dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
+        addColumn(gammaRow + m, Mat3::Zero(), PathChange{}, dGamma, false);
+        // the viscous strain's own rate
+        K(gammaRow + m, gammaRow + m) += rule.rate[l][column + 1] / args.dt;
+      }
+    if (!spec_.thermal) continue;
+
+    // A temperature column of stage `column`: T_b,l moves the point's temperature, and with it
+    // the coupling stress, the fluidity and the heating, and weights node b's row.
+    for (int b = 0; b < nodes_; ++b) {
+      const int thermalColumn = firstThermal_ + b;
+      const double dTemperature = temperatureSlope[b];
+      const Mat3 dPiola = -dTemperature * w * path.F[l] * coupling->gradient();
+      for (int a = 0; a < nodes_; ++a)
+        K.block<3, 1>(momentumRow + 3 * a, thermalColumn) += dPiola * G.row(a).transpose();
+      K(thermalColumn, thermalColumn) += node[b].temperature.slope * w * p.values[b] * entropyRate;
+      if (!branch) continue;
+      const double dFluidity = fluidity.slope * dTemperature;
+      for (int k = 0; k < 6; ++k)
+        K(gammaRow + k, thermalColumn) -= dFluidity * branch->gradient()(kComponent[k][0], kComponent[k][1]);
+      const double dHeating = w * dFluidity * contract(branch->gradient(), branch->gradient());
+      for (int a = 0; a < nodes_; ++a) K(firstThermal_ + a, thermalColumn) -= p.values[a] * dHeating;
     }
   }
+  // the heat capacity, lumped at the nodes: m_a D_s e s'_l
+  if (!spec_.thermal) return;
+  ShapeValues rates = ShapeValues::Zero(), slopes = ShapeValues::Zero();
+  for (int a = 0; a < nodes_; ++a) {
+    rates[a] = node[a].energyRate.value;
+    slopes[a] = node[a].energyRate.slope;
+  }
+  addHeatCapacity(rates, slopes, out);
 }
 
 }  // namespace mpx

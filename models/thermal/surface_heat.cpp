@@ -24,4 +24,9 @@ void SurfaceHeat::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, 
   exchange(T.value, T.slope, spec_.flux * spec_.profile(args.t), out, flows);
 }
 
+void SurfaceHeat::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  const TemperatureJet T = spec_.thermalVariable.stage(args, spec_.thermalDof).temperature;
+  exchange(T.value, T.slope, spec_.flux * spec_.profile(args.t + args.rule->node[args.stage] * args.dt), out, flows);
+}
+
 }  // namespace mpx

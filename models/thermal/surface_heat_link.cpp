@@ -49,4 +49,9 @@ void SurfaceHeatLink::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem
   exchange(T.value, T.slope, ws, out, flows);
 }
 
+void SurfaceHeatLink::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
+  const TemperatureJet T = thermalVariable_.stage(args, dofs()[0]).temperature;
+  exchange(T.value, T.slope, ws, out, flows);
+}
+
 }  // namespace mpx

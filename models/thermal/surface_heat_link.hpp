@@ -22,6 +22,9 @@ class SurfaceHeatLink final : public Component {
   void measure(const double*, Measures&) const override {}
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // eem4: the exchange at the solid node's stage temperature
+  StageForm stageForm() const override { return StageForm::Own; }
+  void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
 
  private:
   // Rows for the solid node at temperature T (slope: dT/ds times the tangent's coefficient).
