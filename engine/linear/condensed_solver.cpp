@@ -20,11 +20,14 @@ CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& patte
     if (!buildCondensation(pattern)) velocities_ = 0;
   }
   reducedRhs_.resize(pattern.rows() - velocities_);
-  // internal variables, numbered as in the velocity-condensed system (one-stage systems only)
+  // every stage's internal variables, numbered as in the velocity-condensed system
   const SparseMatrix& stage = velocities_ > 0 ? reduced_ : pattern;
-  const int velocitiesBefore = velocities_ > 0 ? layout.size(Block::Velocity) : 0;
-  internal_.build(stage, layout.offset(Block::Internal) - velocitiesBefore,
-                  stages == 1 ? layout.size(Block::Internal) : 0);
+  const int velocitiesPerStage = velocities_ > 0 ? layout.size(Block::Velocity) : 0;
+  std::vector<GroupElimination::Range> internalRanges;
+  for (int s = 0; s < stages; ++s)
+    internalRanges.push_back({s * (n - velocitiesPerStage) + layout.offset(Block::Internal) - velocitiesPerStage,
+                              layout.size(Block::Internal)});
+  internal_.build(stage, internalRanges);
   internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
   internalSolution_.resize(stage.rows());
   lu_ = makeSparseLu(static_cast<int>(factorised().rows()));

@@ -7,9 +7,9 @@
 // unknowns only, with the momentum rows in place of the kinematic ones: half the size for
 // mechanics and of the sparsity of a stiffness matrix (2 M/dt^2 + K/2 on its diagonal).
 // A collocation step's system (eem4: the layout once per stage) is condensed stage by stage
-// in the same way. Scenes whose pattern does not have this structure are solved whole. In a
-// one-stage system, internal variables that split into small independent groups (per
-// quadrature point, per Maxwell element) are then eliminated as well
+// in the same way. Scenes whose pattern does not have this structure are solved whole.
+// Internal variables that split into small independent groups (per quadrature point, per
+// Maxwell element, both stages of one together) are then eliminated as well
 // (engine/linear/group_elimination), so that what is factorised is the system of positions,
 // thermal unknowns and multipliers.
 #include "engine/core/layout.hpp"

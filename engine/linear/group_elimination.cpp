@@ -17,18 +17,25 @@ int rootOf(std::vector<int>& parent, int i) {
 }
 }  // namespace
 
-bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) {
-  if (count == 0) return false;
+bool GroupElimination::build(const SparseMatrix& pattern, const std::vector<Range>& ranges) {
   const int n = static_cast<int>(pattern.rows());
-  auto eliminated = [&](int i) { return i >= first && i < first + count; };
+  // slot of each eliminated unknown among them (-1: kept)
+  std::vector<int> slot(n, -1), members;
+  for (const Range& range : ranges)
+    for (int i = range.first; i < range.first + range.count; ++i) {
+      slot[i] = static_cast<int>(members.size());
+      members.push_back(i);
+    }
+  const int count = static_cast<int>(members.size());
+  if (count == 0) return false;
+  auto eliminated = [&](int i) { return slot[i] >= 0; };
 
   // groups: connected sets of the eliminated unknowns' own block
   std::vector<int> parent(count);
   std::iota(parent.begin(), parent.end(), 0);
-  for (int column = first; column < first + count; ++column)
+  for (int column : members)
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
-      if (eliminated(static_cast<int>(it.row())))
-        parent[rootOf(parent, static_cast<int>(it.row()) - first)] = rootOf(parent, column - first);
+      if (eliminated(static_cast<int>(it.row()))) parent[rootOf(parent, slot[it.row()])] = rootOf(parent, slot[column]);
   std::vector<int> groupOf(count, -1);
   std::vector<Group> groups;
   for (int i = 0; i < count; ++i) {
@@ -37,7 +44,7 @@ bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) 
       group = static_cast<int>(groups.size());
       groups.emplace_back();
     }
-    groups[group].members.push_back(first + i);
+    groups[group].members.push_back(members[i]);
     if (groups[group].members.size() > static_cast<std::size_t>(kMaxGroup)) return false;
   }
 
@@ -46,11 +53,12 @@ bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) 
   for (int column = 0; column < n; ++column)
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
       const int row = static_cast<int>(it.row());
-      if (eliminated(column) && !eliminated(row)) rowsOf[groupOf[rootOf(parent, column - first)]].push_back(row);
-      if (eliminated(row) && !eliminated(column)) columnsOf[groupOf[rootOf(parent, row - first)]].push_back(column);
+      if (eliminated(column) && !eliminated(row)) rowsOf[groupOf[rootOf(parent, slot[column])]].push_back(row);
+      if (eliminated(row) && !eliminated(column)) columnsOf[groupOf[rootOf(parent, slot[row])]].push_back(column);
     }
-  first_ = first;
-  count_ = count;
+  keptIndex_.assign(n, -1);
+  for (int i = 0, kept = 0; i < n; ++i)
+    if (!eliminated(i)) keptIndex_[i] = kept++;
   std::vector<Eigen::Triplet<double>> entries;
   for (int column = 0; column < n; ++column)
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
@@ -61,7 +69,7 @@ bool GroupElimination::build(const SparseMatrix& pattern, int first, int count) 
       std::sort(list->begin(), list->end());
       list->erase(std::unique(list->begin(), list->end()), list->end());
       if (list->size() > static_cast<std::size_t>(kMaxCoupling)) {
-        first_ = count_ = 0;
+        keptIndex_.clear();
         return false;
       }
     }
@@ -127,9 +135,8 @@ bool GroupElimination::reduce(const SparseMatrix& matrix) {
 }
 
 void GroupElimination::reduceRhs(const Eigen::VectorXd& rhs, Eigen::VectorXd& reducedRhs) const {
-  const int n = static_cast<int>(rhs.size());
-  reducedRhs.head(first_) = rhs.head(first_);
-  reducedRhs.tail(n - first_ - count_) = rhs.tail(n - first_ - count_);
+  for (Eigen::Index i = 0; i < rhs.size(); ++i)
+    if (keptIndex_[i] >= 0) reducedRhs[keptIndex_[i]] = rhs[i];
   const double* k = matrix_->valuePtr();
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const Group& group = groups_[g];
@@ -145,9 +152,8 @@ void GroupElimination::reduceRhs(const Eigen::VectorXd& rhs, Eigen::VectorXd& re
 
 void GroupElimination::recover(const Eigen::VectorXd& rhs, const Eigen::VectorXd& reducedSolution,
                                Eigen::VectorXd& solution) const {
-  const int n = static_cast<int>(rhs.size());
-  solution.head(first_) = reducedSolution.head(first_);
-  solution.tail(n - first_ - count_) = reducedSolution.tail(n - first_ - count_);
+  for (Eigen::Index i = 0; i < rhs.size(); ++i)
+    if (keptIndex_[i] >= 0) solution[i] = reducedSolution[keptIndex_[i]];
   const double* k = matrix_->valuePtr();
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const Group& group = groups_[g];

@@ -1,7 +1,8 @@
 #pragma once
 // Static condensation of internal variables: unknowns whose own block of the matrix splits
 // into small independent groups (the 6 viscous strains of one quadrature point, the internal
-// variable of one Maxwell element) are eliminated group by group,
+// variable of one Maxwell element; in an eem4 step, those of both stages together) are
+// eliminated group by group,
 //   x_g = B_g^-1 (b_g - K_gc x_c),   K_cc <- K_cc - K_cg B_g^-1 K_gc,
 // before the sparse factorisation. A group couples only to its element's dofs, so the fill
 // stays inside the element's block and the factorised system is that of the elastic problem.
@@ -14,17 +15,21 @@ namespace mpx {
 
 class GroupElimination {
  public:
-  // Largest group eliminated, and most kept rows or columns one group may couple to (a
-  // hexahedron's 24 momentum rows and positions, a joint force's two bodies); beyond either the
-  // internal unknowns are left in place.
-  static constexpr int kMaxGroup = 8;
+  // Largest group eliminated (a point's 6 viscous strains at two stages), and most kept rows
+  // or columns one group may couple to (a hexahedron's 24 momentum rows and positions and 8
+  // temperatures at two stages, a joint force's two bodies); beyond either the internal
+  // unknowns are left in place.
+  static constexpr int kMaxGroup = 12;
   static constexpr int kMaxCoupling = 96;
 
-  // Eliminate the unknowns [first, first + count) of matrices with `pattern` (rows = columns).
-  // Returns false, and leaves the system alone, unless their block splits into groups of at
-  // most kMaxGroup unknowns.
-  bool build(const Eigen::SparseMatrix<double>& pattern, int first, int count);
-  bool active() const { return count_ > 0; }
+  // Eliminate the unknowns of the ranges (first, count) of matrices with `pattern` (rows =
+  // columns). Returns false, and leaves the system alone, unless their block splits into
+  // groups of at most kMaxGroup unknowns.
+  struct Range {
+    int first, count;
+  };
+  bool build(const Eigen::SparseMatrix<double>& pattern, const std::vector<Range>& ranges);
+  bool active() const { return !groups_.empty(); }
 
   // The condensed matrix of `matrix` (pattern as built); false if a group's block is singular.
   bool reduce(const Eigen::SparseMatrix<double>& matrix);
@@ -49,10 +54,10 @@ class GroupElimination {
     std::vector<int> columnEntries;  // members x columns
     std::vector<int> fillEntries;    // rows x columns in the reduced values
   };
-  int keptIndex(int i) const { return i < first_ ? i : i - count_; }
+  int keptIndex(int i) const { return keptIndex_[i]; }
   static double valueAt(const double* values, int entry) { return entry < 0 ? 0.0 : values[entry]; }
 
-  int first_ = 0, count_ = 0;
+  std::vector<int> keptIndex_;  // of each unknown in the reduced system, -1 where eliminated
   std::vector<Group> groups_;
   std::vector<std::pair<int, int>> directEntries_;  // (matrix entry, reduced entry) of kept pairs
   Eigen::SparseMatrix<double> reduced_;
