@@ -1,7 +1,7 @@
 // The fourth-order EEM step (eem4: energy-consistent two-stage Gauss collocation, docs/theory.md
 // section 13): observed order 4 against a fine run, the energy balance and entropy production at
 // every step also at large steps, exact momenta, the stability of a stiff linear dissipative
-// mode, and the scenes it refuses.
+// mode, and the refusal of an element without a stage form.
 #include "support.hpp"
 
 #include "engine/core/input_error.hpp"

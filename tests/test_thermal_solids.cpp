@@ -246,8 +246,9 @@ TEST(ConductionBar, ConvergesAtOrderTwoInTime) {
 
 // eem4 at a stiff step (dt 0.05, about 40 times the fastest conduction mode's time): A-stable
 // with 0 < R(z) < 1 on the negative real axis (docs/theory.md section 13.4), every mode of the
-// hot bar decays without changing sign, so its mean temperature falls at every step and stays
-// above the walls' 300 K; both balances hold at every step.
+// hot bar decays without changing sign; the uniformly hot start gives every mode a positive
+// share of the mean temperature, which therefore falls at every step and stays above the
+// walls' 300 K. Both balances hold at every step.
 TEST(ConductionBar, Eem4CoolsMonotonicallyAtAStiffStep) {
   const CompiledScene scene = loadSceneText(conductionBar(8), "bar.xml");
   const History h = run(*scene.model, Scheme::Eem4, 0.05, 0.5);

@@ -73,6 +73,12 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
     if (prescribedRow[inner[e]] >= 0) prescribedRowEntries_[prescribedRow[inner[e]]].push_back(e);
   for (const PrescribedMotion& p : prescribed)
     for (int l = 0; l < stages; ++l) prescribedDiagonal_.push_back(findEntry(tangent_, p.dof + l * n, p.dof + l * n));
+  // a collocation step's last stage row of a prescribed velocity or temperature holds the end
+  // value, which depends on the dof at every stage
+  if (stages > 1)
+    for (const PrescribedMotion& p : prescribed)
+      for (int m = 0; m < stages; ++m)
+        prescribedEndEntries_.push_back(findEntry(tangent_, p.dof + (stages - 1) * n, p.dof + m * n));
   const auto& components = model.components();
   firstCoupling_ = std::partition_point(components.begin(), components.end(),
                                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); }) -
@@ -159,16 +165,23 @@ void Assembler::imposeStageMotions(const Model& model, const StageArgs& args) {
     for (std::size_t k = 0; k < prescribed.size(); ++k) {
       const PrescribedMotion& p = prescribed[k];
       // a velocity or temperature follows the profile's change since the step's start, as in
-      // the one-stage steps; a displacement gives the velocity as its slope
-      const double value = p.kind == PrescribedKind::Displacement
-                               ? z[p.dof] - p.amplitude * p.profile.slope(t)
-                               : z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
+      // the one-stage steps: at the first stages, and over the whole step at the last one (the
+      // end value's change, so that the step ends on the profile); a displacement gives the
+      // velocity as its slope
+      const bool endRow = p.kind != PrescribedKind::Displacement && stages_ > 1 && l == stages_ - 1 && hasEndEntries(k);
+      const double value = p.kind == PrescribedKind::Displacement ? z[p.dof] - p.amplitude * p.profile.slope(t)
+                           : endRow                               ? args.zEnd[p.dof] - args.zOld[p.dof] -
+                                          p.amplitude * (p.profile(args.t + args.dt) - p.profile(args.t))
+                                    : z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
       // heat through a prescribed temperature enters at the stage temperature its cells use
       StageArgs atStage = args;
       atStage.stage = atStage.column = l;
       const double conjugate =
           p.kind == PrescribedKind::Temperature ? stageTemperature(atStage, p.dof).value : z[p.dof];
-      replaceRow(k, p, value, 1.0, conjugate, l, args.rule->weight[l]);
+      replaceRow(k, p, value, endRow ? args.rule->end[l + 1] : 1.0, conjugate, l, args.rule->weight[l]);
+      if (endRow)
+        for (int m = 0; m < stages_; ++m)
+          tangent_.valuePtr()[prescribedEndEntries_[k * stages_ + m]] = args.rule->end[m + 1];
     }
   }
 }

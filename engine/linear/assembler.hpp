@@ -154,6 +154,14 @@ class Assembler {
   // per prescribed motion and stage (k stages + l): its row, and its diagonal, in tangent_ values
   std::vector<std::vector<int>> prescribedRowEntries_;
   std::vector<int> prescribedDiagonal_;
+  // per prescribed motion and stage m (k stages + m): the entry of column m in its last stage's
+  // row (-1 where the pattern has none: that motion then keeps stage-value rows)
+  std::vector<int> prescribedEndEntries_;
+  bool hasEndEntries(std::size_t k) const {
+    for (int m = 0; m < stages_; ++m)
+      if (prescribedEndEntries_[k * stages_ + m] < 0) return false;
+    return true;
+  }
   // Components per batch, and the smallest batch evaluated in parallel (below it, starting the
   // threads costs more than they save: docs/performance.md, "Parallel assembly").
   static constexpr std::size_t kBatch = 256;

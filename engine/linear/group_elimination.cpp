@@ -18,6 +18,10 @@ int rootOf(std::vector<int>& parent, int i) {
 }  // namespace
 
 bool GroupElimination::build(const SparseMatrix& pattern, const std::vector<Range>& ranges) {
+  keptIndex_.clear();
+  groups_.clear();
+  directEntries_.clear();
+  factors_.clear();
   const int n = static_cast<int>(pattern.rows());
   // slot of each eliminated unknown among them (-1: kept)
   std::vector<int> slot(n, -1), members;

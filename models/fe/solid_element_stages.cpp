@@ -18,6 +18,7 @@
 
 #include "engine/core/stage_gradient.hpp"
 
+#include <cmath>
 #include <optional>
 
 namespace mpx {
@@ -75,7 +76,10 @@ PointPath pointPath(const CellPositions (&basis)[kStages + 1], const CellPositio
 // C', C at that stage and at the end (with its end coefficient), and the norm. All zero for a
 // column that leaves the positions.
 struct PathChange {
-  Mat3 strainRate[kStages] = {Mat3::Zero(), Mat3::Zero()};
+  PathChange() {
+    for (Mat3& rate : strainRate) rate.setZero();
+  }
+  Mat3 strainRate[kStages];
   Mat3 ownStrain = Mat3::Zero(), endStrain = Mat3::Zero();
   double norm = 0.0;
 };
@@ -204,7 +208,8 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
   if (spec_.thermal)
     for (int a = 0; a < nodes_; ++a) {
       node[a] = spec_.thermalVariable.stage(args, spec_.thermalDofs[a]);
-      if (!(node[a].temperature.value > 0.0)) return rejectInadmissible(out);
+      const double T = node[a].temperature.value;
+      if (!(std::isfinite(T) && T > 0.0)) return rejectInadmissible(out);
     }
   auto r = out.residual();
   auto K = out.tangent();
