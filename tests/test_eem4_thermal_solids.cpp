@@ -2,8 +2,8 @@
 // (fourth order in positions and temperatures; E, L and J exact and S never decreasing at a
 // large step, the viscous heat kept inside; without conduction and branch, S exactly
 // constant), the thermoelastic L-block (isolated balances after
-// the load), the L-block with Dirichlet faces (energy and entropy balances with boundary heat
-// at every step) and a face held at a moving temperature (every step ends on it). The step tangents are checked against
+// the load) and a face held at a moving temperature (every step ends on it). The L-block with
+// Dirichlet faces is checked with eem4 in test_thermal_solids (DirichletLBlock). The step tangents are checked against
 // central differences in test_thermal_solids (ThermalCellTangent, eem4 cases).
 #include "support.hpp"
 #include "thermal_solid_checks.hpp"
@@ -103,14 +103,6 @@ TEST(Eem4ThermalSolid, ThermoelasticLBlockKeepsEnergyMomentaAndEntropyAfterTheLo
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
   expectIsolatedBalances(h, "thermoelastic L-block, eem4 dt 0.2");
   expectStepBalances(h, "thermoelastic L-block, eem4 dt 0.2");
-}
-
-TEST(Eem4ThermalSolid, DirichletLBlockKeepsBothBalancesWithBoundaryHeatAtEveryStep) {
-  const CompiledScene scene = loadScene(scenePath("lblock_thermal_dirichlet.xml"));
-  const History h = run(*scene.model, Scheme::Eem4, 0.1, 4.0);
-  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
-  expectStepBalances(h, "Dirichlet L-block, eem4 dt 0.1");
-  EXPECT_GT(std::abs(h.boundaryHeat.back()), 1.0);  // the held faces do exchange heat
 }
 
 // A held face whose temperature follows a table with a kink inside a step: the last stage's

@@ -169,10 +169,10 @@ void Assembler::imposeStageMotions(const Model& model, const StageArgs& args) {
       // end value's change, so that the step ends on the profile); a displacement gives the
       // velocity as its slope
       const bool endRow = p.kind != PrescribedKind::Displacement && stages_ > 1 && l == stages_ - 1 && hasEndEntries(k);
-      const double value = p.kind == PrescribedKind::Displacement ? z[p.dof] - p.amplitude * p.profile.slope(t)
-                           : endRow                               ? args.zEnd[p.dof] - args.zOld[p.dof] -
-                                          p.amplitude * (p.profile(args.t + args.dt) - p.profile(args.t))
-                                    : z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
+      double value = z[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(t) - p.profile(args.t));
+      if (p.kind == PrescribedKind::Displacement) value = z[p.dof] - p.amplitude * p.profile.slope(t);
+      if (endRow)
+        value = args.zEnd[p.dof] - args.zOld[p.dof] - p.amplitude * (p.profile(args.t + args.dt) - p.profile(args.t));
       // heat through a prescribed temperature enters at the stage temperature its cells use
       StageArgs atStage = args;
       atStage.stage = atStage.column = l;
