@@ -33,12 +33,14 @@ struct Workspace {
   std::vector<NodeTemperature> nodes;
 };
 
-// One EEM step from zOld at time t to zNew at time t + dt.
+// One EEM step from zOld at time t to zNew at time t + dt. Without `tangent` only the residual
+// is wanted (Newton iterations that keep a factorisation): a component may skip the tangent.
 struct StepArgs {
   const double* zOld;
   const double* zNew;
   double t;
   double dt;
+  bool tangent = true;
 };
 
 // A rate evaluation F(t, z, zdot); the tangent wanted is alpha dF/dz + beta dF/dzdot (none when
@@ -54,7 +56,8 @@ struct RateArgs {
 // One stage of a Gauss collocation step (eem4) from zOld at t over dt: the state's polynomial
 // passes through zOld and the stage values; stageState[l] and stageRate[l] are z and z' at
 // t + c_l dt, zEnd is z(t + dt). Wanted: the residual of stage `stage` and its derivative with
-// respect to the values of stage `column`.
+// respect to the values of stage `column`; without `tangent`, the residual alone (column =
+// stage), and a component may skip the tangent.
 struct StageArgs {
   const CollocationRule* rule;
   const double* zOld;
@@ -65,10 +68,13 @@ struct StageArgs {
   double dt;
   int stage;
   int column;
-  // The rate form at this stage, with the coefficients of the tangent for stage `column`.
+  bool tangent = true;
+  // The rate form at this stage, with the coefficients of the tangent for stage `column` (none
+  // without `tangent`).
   RateArgs rateArgs() const {
-    return {stageState[stage], stageRate[stage], t + rule->node[stage] * dt, stage == column ? 1.0 : 0.0,
-            rule->rate[stage][column + 1] / dt};
+    const double alpha = tangent && stage == column ? 1.0 : 0.0;
+    return {stageState[stage], stageRate[stage], t + rule->node[stage] * dt, alpha,
+            tangent ? rule->rate[stage][column + 1] / dt : 0.0};
   }
 };
 

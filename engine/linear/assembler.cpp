@@ -94,9 +94,9 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
     locals_.push_back({0, localResidual_.data() + b * largest, localTangent_.data() + b * largest * largest});
 }
 
-void Assembler::clear() {
+void Assembler::clear(bool tangent) {
   residual_.setZero();
-  std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
+  if (tangent) std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
   flows_ = Flows{};
   if (keepComponentFlows_) std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }
@@ -149,10 +149,12 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
       c.rateLocal(args.rateArgs(), w, l, f);
   };
   // each stage row block with its own stage's columns first: that pass gives the residual
+  const int columnPasses = args.tangent ? stages_ : 1;
   for (args.stage = 0; args.stage < stages_; ++args.stage)
-    for (int offset = 0; offset < stages_; ++offset) {
+    for (int offset = 0; offset < columnPasses; ++offset) {
       args.column = (args.stage + offset) % stages_;
-      add(model, ws, {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, true},
+      add(model, ws,
+          {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent},
           evaluate);
     }
 }

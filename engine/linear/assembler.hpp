@@ -27,11 +27,13 @@ class Assembler {
   Assembler(const Assembler&) = delete;
   Assembler& operator=(const Assembler&) = delete;
 
-  // Zero residual, tangent values and the flows of the evaluation.
-  void clear();
-  // Add every component's EEM step residual and tangent.
+  // Zero residual and the flows of the evaluation, and the tangent values if one is to be
+  // evaluated (tangent() otherwise keeps the last one evaluated).
+  void clear(bool tangent = true);
+  // Add every component's EEM step residual and tangent (the residual alone without
+  // args.tangent: the tangent is then left as it was).
   void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
-    add(model, ws, {0, 1.0, 1.0, true, true},
+    add(model, ws, {0, 1.0, 1.0, true, args.tangent},
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
   }
   // Replace the rows of prescribed motions for the step zOld -> zNew: v' = V(t + dt) (tangent
@@ -48,7 +50,8 @@ class Assembler {
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });
   }
   // Add every stage's residual (its flows weighted b_l) and the tangent blocks of all pairs
-  // of stages: one evaluation of every component per pair.
+  // of stages: one evaluation of every component per pair; without args.tangent one per stage,
+  // for the residual alone.
   void addStages(const Model& model, Workspace& ws, StageArgs args);
   // Prescribed motions at every stage: v_l = V'(t_l) or the temperature, tangent 1.
   void imposeStageMotions(const Model& model, const StageArgs& args);
@@ -82,7 +85,8 @@ class Assembler {
         LocalSystem& local = locals_[b];
         local.n = static_cast<int>(components[first + b]->dofs().size());
         std::fill_n(local.r, local.n, 0.0);
-        std::fill_n(local.k, local.n * local.n, 0.0);
+        // a residual-only pass leaves what a component writes into its tangent there, unread
+        if (pass.withTangent) std::fill_n(local.k, local.n * local.n, 0.0);
         localFlows_[b] = Flows{};
         evaluate(*components[first + b], ws, local, localFlows_[b]);
       };

@@ -8,7 +8,7 @@ namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 }  // namespace
 
-CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : pattern_(&pattern) {
+CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern) : factorizedTangent_(pattern) {
   // positions come first in the layout, velocities right after, dof for dof; a collocation
   // step's system (eem4) repeats the layout once per stage, and each stage's kinematic rows
   // pair with its own velocities in the same way
@@ -122,8 +122,8 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
 }
 
 bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
-  tangent_ = &tangent;
-  if (velocities_ > 0) condenseVelocities(tangent);
+  std::copy_n(tangent.valuePtr(), tangent.nonZeros(), factorizedTangent_.valuePtr());
+  if (velocities_ > 0) condenseVelocities(factorizedTangent_);
   if (!internal_.active()) return lu_->factorize(velocityCondensed(), repivot);
   return internal_.reduce(velocityCondensed()) && lu_->factorize(internal_.reduced(), repivot);
 }
@@ -170,7 +170,7 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
     solveVelocityCondensed(increment);
     return;
   }
-  const SparseMatrix& K = *tangent_;
+  const SparseMatrix& K = factorizedTangent_;
   const double* k = K.valuePtr();
   const int n = static_cast<int>(K.rows()), nv = velocities_;
 
@@ -195,7 +195,7 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
 }
 
 std::string CondensedSolver::describe() const {
-  const std::string size = std::to_string(condensedSize()) + " of " + std::to_string(pattern_->rows()) +
+  const std::string size = std::to_string(condensedSize()) + " of " + std::to_string(factorizedTangent_.rows()) +
                            " unknowns factorised by " + lu_->name();
   if (velocities_ > 0)
     return size + " (velocities" + (internal_.active() ? " and internal variables" : "") + " eliminated)";

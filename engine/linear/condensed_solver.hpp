@@ -29,10 +29,10 @@ class CondensedSolver {
   // `pattern`: the fixed pattern of every tangent this solver will see.
   CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern);
 
-  // Factorise the condensed form of `tangent`, which must stay alive until the next factorize:
-  // solve reads its kinematic rows and velocity couplings. If the tangent is re-assembled in
-  // between (simplified Newton), solve mixes its current values with the kept factorisation,
-  // an approximate inverse, which is all simplified Newton asks. Returns false if singular.
+  // Factorise the condensed form of `tangent` (of the pattern given at construction). Its values
+  // are kept, since solve reads its kinematic rows and velocity couplings: the tangent may be
+  // re-assembled, or left unevaluated, while the factorisation is reused (simplified Newton).
+  // Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
   // Forget the factorisation, its pivots and analysis: the next factorize starts as the first.
   void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows())); }
@@ -70,9 +70,11 @@ class CondensedSolver {
   // the velocity unknown of kinematic row i
   int velocityOf(int i) const { return kinematicRow_[i] + velocityOffset_; }
   // The matrix after velocity condensation (the tangent itself without it).
-  const Eigen::SparseMatrix<double>& velocityCondensed() const { return velocities_ > 0 ? reduced_ : *tangent_; }
+  const Eigen::SparseMatrix<double>& velocityCondensed() const {
+    return velocities_ > 0 ? reduced_ : factorizedTangent_;
+  }
   const Eigen::SparseMatrix<double>& factorised() const {
-    return internal_.active() ? internal_.reduced() : velocities_ > 0 ? reduced_ : *pattern_;
+    return internal_.active() ? internal_.reduced() : velocityCondensed();
   }
 
   int velocities_ = 0;      // velocity unknowns eliminated, all stages (0: solved whole)
@@ -83,8 +85,7 @@ class CondensedSolver {
   // (a velocity's momentum row takes its position's place)
   std::vector<int> kinematicRow_, kinematicIndex_, reducedIndex_;
   std::string wholeSystemReason_;
-  const Eigen::SparseMatrix<double>* pattern_;
-  const Eigen::SparseMatrix<double>* tangent_ = nullptr;
+  Eigen::SparseMatrix<double> factorizedTangent_;  // the tangent last factorised (its pattern before)
   Eigen::SparseMatrix<double> reduced_;
   std::vector<int> pivotEntry_;                       // per kinematic row i (all stages): place of d_i in K
   std::vector<std::vector<RowEntry>> kinematicRows_;  // per kinematic row i (all stages)

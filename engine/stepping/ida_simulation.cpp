@@ -158,7 +158,7 @@ void IdaProblem::errorHandler(int code, const char*, const char* function, char*
 }
 
 void IdaProblem::evaluate(double t, N_Vector y, N_Vector yp, double alpha, double cj) {
-  assembler_.clear();
+  assembler_.clear(alpha != 0.0 || cj != 0.0);
   assembler_.addRate(model_, workspace_, {N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, alpha, cj}, 1.0);
   assembler_.imposeRateMotions(model_, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), t, cj);
 }

@@ -8,6 +8,9 @@ namespace mpx {
 namespace {
 // Backtracking gives up (and the step is cut back) below this fraction of a Newton step.
 constexpr double kSmallestLineSearchStep = 1.0 / 1024;
+// Simplified Newton keeps a factorisation across step-size changes up to this fraction (the
+// contraction check refreshes it when the old step's tangent no longer contracts well).
+constexpr double kReusableStepChange = 0.2;
 
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
@@ -43,35 +46,41 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
   }
 }
 
-Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
-  assembler_.clear();
+Assembler& Integrator::evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt,
+                                bool tangent) {
+  assembler_.clear(tangent);
   if (scheme_ == Scheme::Eem4) {
-    addStages(zOld, zNew, t, dt);
+    addStages(zOld, zNew, t, dt, tangent);
     return assembler_;
   }
   if (scheme_ == Scheme::Eem) {
-    assembler_.addStep(model_, workspace_, {zOld.data(), zNew.data(), t, dt});
+    assembler_.addStep(model_, workspace_, {zOld.data(), zNew.data(), t, dt, tangent});
   } else {
-    addRateForm(zOld, zNew, t, dt);
+    addRateForm(zOld, zNew, t, dt, tangent);
   }
   assembler_.imposeStepMotions(model_, zOld.data(), zNew.data(), t, dt);
   return assembler_;
 }
 
-void Integrator::addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt) {
+void Integrator::addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt,
+                             bool tangent) {
   zDot_ = (zNew - zOld) / dt;
+  // the tangent's coefficients (alpha = beta = 0: the residual alone)
+  const double rateCoefficient = tangent ? 1.0 / dt : 0.0, stateCoefficient = tangent ? 1.0 : 0.0;
   // midpoint: F(t + dt/2, (z + z')/2, (z' - z)/dt)
   if (scheme_ == Scheme::Midpoint) {
     zMid_ = 0.5 * (zOld + zNew);
-    assembler_.addRate(model_, workspace_, {zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5, 1.0 / dt}, 1.0);
+    assembler_.addRate(model_, workspace_,
+                       {zMid_.data(), zDot_.data(), t + 0.5 * dt, 0.5 * stateCoefficient, rateCoefficient}, 1.0);
     return;
   }
   // trapezoidal: mean of F at both end points with the same (z' - z)/dt
-  assembler_.addRate(model_, workspace_, {zOld.data(), zDot_.data(), t, 0.0, 1.0 / dt}, 0.5);
-  assembler_.addRate(model_, workspace_, {zNew.data(), zDot_.data(), t + dt, 1.0, 1.0 / dt}, 0.5);
+  assembler_.addRate(model_, workspace_, {zOld.data(), zDot_.data(), t, 0.0, rateCoefficient}, 0.5);
+  assembler_.addRate(model_, workspace_, {zNew.data(), zDot_.data(), t + dt, stateCoefficient, rateCoefficient}, 0.5);
 }
 
-void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt) {
+void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt,
+                           bool tangent) {
   const int n = static_cast<int>(zOld.size());
   const double* state[CollocationRule::kMostStages] = {};
   const double* rate[CollocationRule::kMostStages] = {};
@@ -85,7 +94,7 @@ void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& s
     state[l] = stages.data() + l * n;
     rate[l] = stageRates_.data() + l * n;
   }
-  const StageArgs args{&rule_, zOld.data(), stageEnd_.data(), state, rate, t, dt, 0, 0};
+  const StageArgs args{&rule_, zOld.data(), stageEnd_.data(), state, rate, t, dt, 0, 0, tangent};
   assembler_.addStages(model_, workspace_, args);
   assembler_.imposeStageMotions(model_, args);
 }
@@ -119,24 +128,29 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
                   what, iteration, incrementNorm, residualNorm, note);
     return false;
   };
-  // the residual norm relative to row scales taken at the current iterate
+  // Simplified Newton's iterates need the residual alone while the factorisation is kept; the
+  // tangent is evaluated where it is factorised.
+  const bool simplified = settings_.reuseContraction > 0.0;
+  bool refresh = !simplified || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
+  bool tangentAtIterate = refresh;
+  // the residual norm relative to row scales taken from the tangent at the current iterate
+  // (after a residual-only evaluation, from the last tangent evaluated)
   auto rescaledNorm = [&](Assembler& system) {
     stateScale_ = zNew.cwiseAbs() + unknownScale_;
-    system.updateRowScale(stateScale_);
+    if (tangentAtIterate) system.updateRowScale(stateScale_);
     return system.relativeResidualNorm();
   };
 
   // a predictor whose residual is not finite is no start: begin from the old state
-  Assembler& system = evaluate(zOld, zNew, t, dt);
+  Assembler& system = evaluate(zOld, zNew, t, dt, tangentAtIterate);
   double residualNorm = rescaledNorm(system);
   if (!std::isfinite(residualNorm)) {
     zNew = zOld.replicate(rule_.stages, 1);
-    evaluate(zOld, zNew, t, dt);
+    evaluate(zOld, zNew, t, dt, tangentAtIterate);
     residualNorm = rescaledNorm(system);
   }
   double incrementNorm = INFINITY;
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
-  bool refresh = factorizedDt_ != dt || settings_.reuseContraction <= 0.0;
   for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance && residualNorm <= settings_.residualTolerance) {
       outcome.energy += system.flows() * dt;
@@ -152,18 +166,24 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     // replaced, before the step counts as failed
     double step = 1.0;
     for (bool repivot = false;;) {
+      if (refresh && !tangentAtIterate) {
+        tangentAtIterate = true;
+        evaluate(zOld, zNew, t, dt);
+        residualNorm = rescaledNorm(system);
+      }
       if (refresh && !refactorize(dt, repivot, outcome))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
       solver_.solve(system.residual(), increment_);
-      step = lineSearch(zOld, t, dt, zNew, residualNorm);
+      step = lineSearch(zOld, t, dt, zNew, residualNorm, !simplified);
       if (step > 0.0) break;
       if (refresh && repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
       repivot = refresh;
       refresh = true;
-      evaluate(zOld, zNew, t, dt);  // restore the tangent at zNew
+      tangentAtIterate = false;  // the trials replaced the evaluation at zNew
     }
     zNew.swap(trial_);
+    tangentAtIterate = !simplified;
     ++outcome.iterations;
     const double previousIncrementNorm = incrementNorm;
     incrementNorm = step * (increment_.array().abs() / (zNew.array().abs() + incrementScale_.array())).maxCoeff();
@@ -188,10 +208,10 @@ bool Integrator::refactorize(double dt, bool repivot, StepOutcome& outcome) {
 }
 
 double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
-                              double residualNorm) {
+                              double residualNorm, bool tangent) {
   for (double step = 1.0; step >= kSmallestLineSearchStep; step *= 0.5) {
     trial_ = zNew + step * increment_;
-    evaluate(zOld, trial_, t, dt);
+    evaluate(zOld, trial_, t, dt, tangent);
     const double trialNorm = assembler_.relativeResidualNorm();
     if (trialNorm <= (1.0 - 1e-4 * step) * residualNorm ||
         (std::isfinite(trialNorm) && residualNorm <= settings_.residualTolerance))

@@ -31,8 +31,8 @@ struct NewtonSettings {
   int maxCutbacks = 6;  // each halves the step
   // Simplified Newton: keep a factorisation across iterations and steps while the increments
   // contract by at least this factor per iteration; refresh it (from the current tangent)
-  // when they do not, when dt changes or when the line search fails. 0 (default): full
-  // Newton, which measures faster on every scene so far (docs/performance.md).
+  // when they do not, when dt changes by more than a fifth or when the line search fails. The
+  // iterates in between evaluate the residual alone. 0 (default): full Newton.
   double reuseContraction = 0.0;
   // Full Newton keeps its factorisation for the next iteration once the relative increment is
   // below this (0, the default: a fresh factorisation at every iteration). At 1e-4 the
@@ -72,10 +72,11 @@ class Integrator {
   void checkpoint(LoopState& out);
   void resume(const LoopState& saved);
 
-  // Residual and tangent of the step from zOld with Newton unknowns `unknowns`: the end state
-  // for one-stage schemes, the stage values one after the other for eem4 (exposed for tangent
-  // tests).
-  Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& unknowns, double t, double dt);
+  // Residual and tangent (without `tangent`: the residual alone) of the step from zOld with
+  // Newton unknowns `unknowns`: the end state for one-stage schemes, the stage values one after
+  // the other for eem4 (exposed for tangent tests).
+  Assembler& evaluate(const Eigen::VectorXd& zOld, const Eigen::VectorXd& unknowns, double t, double dt,
+                      bool tangent = true);
   // Newton unknowns of the step: the end state, or (eem4) stageCount() stage values.
   int stageCount() const { return rule_.stages; }
   Scheme scheme() const { return scheme_; }
@@ -83,21 +84,22 @@ class Integrator {
 
  private:
   // Midpoint or trapezoidal residual of the step from the components' rate form.
-  void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt);
+  void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt, bool tangent);
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
   // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess).
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
   bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
   // eem4: the stage rates and the end state of the stage polynomial, then its residual.
-  void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt);
+  void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
   // z(t + dt) of the stage polynomial.
   void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
   // Factorise the tangent of the last evaluation; false if singular.
   bool refactorize(double dt, bool repivot, StepOutcome& outcome);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
-  // evaluated at zNew + step increment_ in trial_); 0 if none does.
-  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew, double residualNorm);
+  // evaluated at zNew + step increment_ in trial_, with the tangent if asked); 0 if none does.
+  double lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew, double residualNorm,
+                    bool tangent);
 
   const Model& model_;
   Scheme scheme_;

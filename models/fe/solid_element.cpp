@@ -271,6 +271,8 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
     e.strainFactor = 0.25;
     e.gammaFactor = 0.5;
     e.gammaRateCoefficient = 1.0 / args.dt;
+    // residual only: assemblePoint stops after the residual rows
+    if (!args.tangent) e.tangentScale = e.gammaRateCoefficient = 0.0;
     if (spec_.branch) {
       const Mat3 gamma0 = viscousStrain(args.zOld, q), gamma1 = viscousStrain(args.zNew, q);
       e.branchStress = spec_.branch->stress(0.5 * (C0 + C1), 0.5 * (gamma0 + gamma1));

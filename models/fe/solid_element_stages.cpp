@@ -268,6 +268,7 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
     if (spec_.thermal)
       for (int a = 0; a < nodes_; ++a)
         r[firstThermal_ + a] += node[a].temperature.value * w * p.values[a] * entropyRate - p.values[a] * heating;
+    if (!args.tangent) continue;
 
     // A position or viscous-strain column of stage `column`: the positions move F by dF (the
     // path by d), the viscous strain by dGamma.
