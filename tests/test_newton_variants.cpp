@@ -5,7 +5,12 @@
 // the Newton tolerance and keeps the energy balance.
 #include "support.hpp"
 
+#include "engine/stepping/adaptive_simulation.hpp"
+
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
 
 namespace mpx::test {
 namespace {
@@ -67,6 +72,51 @@ TEST_P(NewtonVariants, ReachTheFullNewtonSolutionToTheTolerance) {
         EXPECT_LE(h.summary.newtonIterations, reference.summary.newtonIterations + 2) << v.name;
       }
     }
+  }
+}
+
+// Under adaptive steps simplified Newton keeps a factorisation across step-size changes of up
+// to a fifth: the steps still solve the same equations, so the run takes the same steps to the
+// same states as with full Newton, and every accepted step keeps the EEM balances.
+TEST(SimplifiedNewton, AdaptiveStepsReachTheFullNewtonRun) {
+  const CompiledScene scene = loadScene(scenePath("lblock_viscoelastic.xml"));
+  const Model& model = *scene.model;
+  NewtonSettings full = scene.settings.newton, simplified = full;
+  full.reuseContraction = 0.0;
+  simplified.reuseContraction = 0.5;
+  constexpr double kEndTime = 3.0, kRtol = 1e-5;
+  const Eigen::VectorXd scale = model.dofScale();
+  const int withScale = model.layout().offset(Block::Multiplier);
+  for (const Scheme scheme : {Scheme::Eem, Scheme::Eem4}) {
+    SCOPED_TRACE(schemeName(scheme));
+    auto runWith = [&](const NewtonSettings& newton) {
+      return collect([&](const StepSink& sink) {
+        return simulateAdaptive(model, {scheme, 0.05, kEndTime, newton, {}}, {kRtol, kRtol, 0.0}, sink);
+      });
+    };
+    const History reference = runWith(full), h = runWith(simplified);
+    ASSERT_FALSE(reference.summary.failed) << reference.summary.failure;
+    ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+    // what simplified Newton is for, on steps whose sizes change
+    EXPECT_LT(h.summary.factorizations, 0.5 * h.summary.newtonIterations);
+    const auto [shortest, longest] = std::minmax_element(h.dt.begin() + 1, h.dt.end());
+    EXPECT_GT(*longest, 1.5 * *shortest);
+    // the step sequences agree, and the states to well below the error tolerance
+    ASSERT_EQ(h.dt.size(), reference.dt.size());
+    const Eigen::VectorXd magnitude = reference.states.back().cwiseAbs() + scale;
+    const double difference =
+        ((h.states.back() - reference.states.back()).head(withScale).array() / magnitude.head(withScale).array())
+            .abs()
+            .maxCoeff();
+    const double balance = maxBalanceDrift(h) / largestEnergy(h);
+    std::printf(
+        "%s: %zu steps, %ld factorisations for %ld iterations (full: %ld); states differ by %.2e; balance %.2e\n",
+        schemeName(scheme).c_str(), h.dt.size() - 1, h.summary.factorizations, h.summary.newtonIterations,
+        reference.summary.factorizations, difference, balance);
+    EXPECT_LT(difference, 1e-7);
+    // the block starts at rest: the balance is judged against the work the load does
+    EXPECT_LT(balance, 1e-11);
+    EXPECT_EQ(firstEntropyDecrease(h), -1);
   }
 }
 
