@@ -9,6 +9,7 @@
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
 
+#include <omp.h>
 #include <Eigen/Sparse>
 
 #include <algorithm>
@@ -90,9 +91,9 @@ class Assembler {
         localFlows_[b] = Flows{};
         evaluate(*components[first + b], ws, local, localFlows_[b]);
       };
-      // a small batch stays outside OpenMP altogether (even a region that runs on one thread
-      // allocates its team)
-      if (count >= kSmallestParallelBatch) {
+      // a small batch, or a single thread, stays outside OpenMP altogether: a region that runs
+      // on one thread allocates its team at every entry (libgomp keeps only larger teams)
+      if (count >= kSmallestParallelBatch && omp_get_max_threads() > 1) {
 #pragma omp parallel for schedule(static)
         for (int b = 0; b < count; ++b) evaluateSlot(b);
       } else {
