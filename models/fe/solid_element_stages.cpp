@@ -96,21 +96,23 @@ PathChange pathChange(const PointPath& path, const CollocationRule& rule, int co
   return change;
 }
 
-// An energy of C along a point's path (W, or the coupling's L) and its stage gradient at stage l.
+// An energy of C along a point's path (W, or the coupling's L) and its stage gradient at stage l;
+// with `tangent`, also what change() needs.
 class StrainEnergyPath {
  public:
   StrainEnergyPath(const HyperelasticMaterial& law, const PointPath& path, const CollocationRule& rule, int stage,
-                   int column)
+                   int column, bool tangent)
       : law_(law), path_(path), rule_(rule), stage_(stage), column_(column) {
     double defect = law.energyDifference(path.C0, path.CEnd);
     for (int j = 0; j < rule.stages; ++j) {
       stress_[j] = law.stress(path.C[j]);
       defect -= rule.weight[j] * 0.5 * contract(stress_[j], path.strainRate[j]);
     }
-    stressEnd_ = law.stress(path.CEnd);
-    columnTangent_ = law.stressIncrement(path.C[column], path.strainRate[column]);
     correction_ = correction(defect, path.norm);
     gradient_ = stress_[stage] + 2.0 * correction_.coefficient * path.strainRate[stage];
+    if (!tangent) return;
+    stressEnd_ = law.stress(path.CEnd);
+    columnTangent_ = law.stressIncrement(path.C[column], path.strainRate[column]);
   }
   const Mat3& gradient() const { return gradient_; }
 
@@ -219,7 +221,7 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
     const double w = p.weight;
     const PointPath path = pointPath(basis, xRate, xEnd, G, rule);
     if (!(path.F[l].determinant() > 0.0) || !(path.FEnd.determinant() > 0.0)) return rejectInadmissible(out);
-    const StrainEnergyPath elastic(*spec_.material, path, rule, l, column);
+    const StrainEnergyPath elastic(*spec_.material, path, rule, l, column, args.tangent);
     Mat3 totalStress = elastic.gradient();
 
     // a thermal point: its stage temperature and the coupling's stage gradient, whose power is
@@ -228,7 +230,7 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
     double temperature = 0.0, shift = 0.0, entropyRate = 0.0;
     ShapeValues temperatureSlope = ShapeValues::Zero();
     if (spec_.thermal) {
-      coupling.emplace(*coupling_, path, rule, l, column);
+      coupling.emplace(*coupling_, path, rule, l, column, args.tangent);
       for (int a = 0; a < nodes_; ++a) {
         temperature += p.values[a] * node[a].temperature.value;
         temperatureSlope[a] = p.values[a] * node[a].temperature.slope;
