@@ -6,6 +6,8 @@
 #include "support.hpp"
 
 #include "engine/stepping/adaptive_simulation.hpp"
+#include "engine/stepping/integrator.hpp"
+#include "engine/stepping/loop_state.hpp"
 
 #include <gtest/gtest.h>
 
@@ -103,6 +105,7 @@ TEST(SimplifiedNewton, AdaptiveStepsReachTheFullNewtonRun) {
     EXPECT_GT(*longest, 1.5 * *shortest);
     // the step sequences agree, and the states to well below the error tolerance
     ASSERT_EQ(h.dt.size(), reference.dt.size());
+    for (std::size_t k = 1; k < h.dt.size(); ++k) ASSERT_NEAR(h.dt[k], reference.dt[k], 1e-6 * reference.dt[k]) << k;
     const Eigen::VectorXd magnitude = reference.states.back().cwiseAbs() + scale;
     const double difference =
         ((h.states.back() - reference.states.back()).head(withScale).array() / magnitude.head(withScale).array())
@@ -117,6 +120,44 @@ TEST(SimplifiedNewton, AdaptiveStepsReachTheFullNewtonRun) {
     // the block starts at rest: the balance is judged against the work the load does
     EXPECT_LT(balance, 1e-11);
     EXPECT_EQ(firstEntropyDecrease(h), -1);
+  }
+}
+
+// A kept factorisation serves the next step when its size changes by at most a fifth; a larger
+// change, or a restart after checkpoint(), factorises afresh. Steps from the same state with the
+// same step size reach the same end state either way (to the Newton tolerance).
+TEST(SimplifiedNewton, KeepsItsFactorisationAcrossSmallStepChangesOnly) {
+  const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));
+  const Model& model = *scene.model;
+  NewtonSettings settings = scene.settings.newton;
+  settings.reuseContraction = 0.5;
+  settings.predictor = false;
+  const double dt = 0.01;
+  const Eigen::VectorXd& z0 = model.initialState();
+  Eigen::VectorXd z1(z0.size()), z2(z0.size()), fresh(z0.size());
+  struct Case {
+    double stepChange;
+    bool restart;
+    bool refactorises;
+  };
+  for (const Case c :
+       {Case{1.15, false, false}, Case{0.85, false, false}, Case{1.3, false, true}, Case{1.15, true, true}}) {
+    SCOPED_TRACE(testing::Message() << "step change " << c.stepChange << (c.restart ? ", after a checkpoint" : ""));
+    Integrator integrator(model, Scheme::Eem, settings);
+    const StepOutcome first = integrator.advance(z0, 0.0, dt, z1);
+    ASSERT_TRUE(first.converged) << first.failure;
+    ASSERT_GE(first.factorizations, 1);
+    if (c.restart) {
+      LoopState saved;
+      integrator.checkpoint(saved);
+    }
+    const StepOutcome second = integrator.advance(z1, dt, c.stepChange * dt, z2);
+    ASSERT_TRUE(second.converged) << second.failure;
+    EXPECT_EQ(second.factorizations > 0, c.refactorises) << second.factorizations << " factorisations";
+    // the kept factorisation changes how the step is solved, not its end state
+    Integrator fullNewton(model, Scheme::Eem, scene.settings.newton);
+    ASSERT_TRUE(fullNewton.advance(z1, dt, c.stepChange * dt, fresh).converged);
+    EXPECT_LT(((z2 - fresh).array() / (fresh.array().abs() + model.dofScale().array())).abs().maxCoeff(), 1e-9);
   }
 }
 

@@ -32,7 +32,8 @@ class Assembler {
   // evaluated (tangent() otherwise keeps the last one evaluated).
   void clear(bool tangent = true);
   // Add every component's EEM step residual and tangent (the residual alone without
-  // args.tangent: the tangent is then left as it was).
+  // args.tangent: the tangent then keeps the last one assembled, but for the rows of prescribed
+  // motions, which the impose functions rewrite).
   void addStep(const Model& model, Workspace& ws, const StepArgs& args) {
     add(model, ws, {0, 1.0, 1.0, true, args.tangent},
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.eemLocal(args, w, l, f); });
@@ -45,7 +46,7 @@ class Assembler {
   void imposeRateMotions(const Model& model, const double* z, const double* zdot, double t, double beta);
   // Add every component's rate residual and tangent times `weight` (trapezoidal rule: two
   // evaluations of weight 1/2). With alpha = beta = 0 only the residual is wanted (IDA's
-  // residual calls): the tangent is left at zero.
+  // residual calls): the tangent is left as it was.
   void addRate(const Model& model, Workspace& ws, const RateArgs& args, double weight) {
     add(model, ws, {0, weight, weight, true, args.alpha != 0.0 || args.beta != 0.0},
         [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) { c.rateLocal(args, w, l, f); });

@@ -94,7 +94,7 @@ class Integrator {
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
   // z(t + dt) of the stage polynomial.
   void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
-  // Factorise the tangent of the last evaluation; false if singular.
+  // Factorise the tangent of the last evaluation that assembled one; false if singular.
   bool refactorize(double dt, bool repivot, StepOutcome& outcome);
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
   // evaluated at zNew + step increment_ in trial_, with the tangent if asked); 0 if none does.

@@ -172,7 +172,8 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
       const auto [i, j] = kComponent[k];
       r[gammaRow + k] = e.gammaRate(i, j) - fluidity * e.branchStress(i, j);
     }
-  // a residual-only rate evaluation (every tangent term below carries s or gammaRateCoefficient)
+  // a residual-only evaluation, of a rate or an EEM step (every tangent term below carries s or
+  // gammaRateCoefficient)
   if (s == 0.0 && e.gammaRateCoefficient == 0.0) return;
 
   // a thermal cell's nodes are heated by the branch: d(S_v:S_v/eta) = 2 S_v:dS_v/eta
