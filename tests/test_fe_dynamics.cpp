@@ -580,7 +580,7 @@ TEST(FlexiblePendulum, PenaltyJointsKeepTheBalanceAndHoldToForceOverStiffness) {
 // the plain LU's to the conditioning of the saddle-point systems of multiplier scenes. What
 // simplified Newton relies on holds too: the factorisation answers alike after the tangent is
 // re-assembled elsewhere, and an evaluation of the residual alone gives the full one's residual
-// and flows bit for bit and leaves the last tangent evaluated in place.
+// and flows (bit for bit, and for eem4 to round-off) and leaves the last tangent evaluated in place.
 class CondensedNewton : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
@@ -632,10 +632,15 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
     VectorXd again(unknowns.size());
     condensed.solve(residual, again);
     EXPECT_EQ((again - increment).lpNorm<Eigen::Infinity>(), 0.0);
+    // (eem4's residual alone sums each solid cell's stages after the other components, in
+    // another order: the same to round-off)
     integrator.evaluate(zOld, unknowns, 2.0, 0.1, false);
-    EXPECT_EQ((system.residual() - residual).lpNorm<Eigen::Infinity>(), 0.0);
-    EXPECT_EQ(system.flows().dissipated, flows.dissipated);
-    EXPECT_EQ(system.flows().externalWork, flows.externalWork);
+    const double roundOff = stages > 1 ? 1e-14 : 0.0;
+    EXPECT_LE((system.residual() - residual).lpNorm<Eigen::Infinity>(), roundOff * residual.lpNorm<Eigen::Infinity>());
+    EXPECT_LE(std::abs(system.flows().dissipated - flows.dissipated), roundOff * std::abs(flows.dissipated));
+    EXPECT_LE(std::abs(system.flows().externalWork - flows.externalWork), roundOff * std::abs(flows.externalWork));
+    std::printf("  residual alone: differs by %.2e of the largest residual entry\n",
+                (system.residual() - residual).lpNorm<Eigen::Infinity>() / residual.lpNorm<Eigen::Infinity>());
     EXPECT_EQ((values(system.tangent()) - tangentElsewhere).lpNorm<Eigen::Infinity>(), 0.0);
   }
 }

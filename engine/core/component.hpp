@@ -156,6 +156,13 @@ class Component {
   enum class StageForm { None, RateAtStages, Own };
   virtual StageForm stageForm() const { return StageForm::None; }
   virtual void stageLocal(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem& /*out*/, Flows& /*flows*/) const {}
+  // A residual-only eem4 evaluation: a component whose stages share work (a solid cell: each
+  // point's path through all stages) gives every stage's residual at once, out[l] and flows[l]
+  // for stage l, in place of one stageLocal per stage. Such a component neither publishes nor
+  // reads node temperatures, which the stages' evaluations exchange one stage at a time.
+  virtual bool evaluatesStagesTogether() const { return false; }
+  virtual void stageResiduals(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem* /*out*/,
+                              Flows* /*flows*/) const {}
 
  protected:
   Component(std::string name, std::vector<int> dofs) : name_(std::move(name)), dofs_(std::move(dofs)) {}

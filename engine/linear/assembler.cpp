@@ -83,15 +83,17 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
   firstCoupling_ = std::partition_point(components.begin(), components.end(),
                                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); }) -
                    components.begin();
-  std::size_t largest = 0;
-  for (const auto& component : components) largest = std::max(largest, component->dofs().size());
+  for (std::size_t c = 0; c < components.size(); ++c)
+    if (stages > 1 && components[c]->evaluatesStagesTogether()) together_.push_back(c);
+  for (const auto& component : components) largest_ = std::max(largest_, component->dofs().size());
   const std::size_t slots = std::min(kBatch, components.size());
-  localResidual_.assign(slots * largest, 0.0);
-  localTangent_.assign(slots * largest * largest, 0.0);
-  localFlows_.resize(slots);
+  localResidual_.assign(slots * stages * largest_, 0.0);
+  localTangent_.assign(slots * largest_ * largest_, 0.0);
+  localFlows_.resize(slots * stages);
   componentFlows_.resize(components.size() + 1);
   for (std::size_t b = 0; b < slots; ++b)
-    locals_.push_back({0, localResidual_.data() + b * largest, localTangent_.data() + b * largest * largest});
+    locals_.push_back(
+        {0, localResidual_.data() + b * stages * largest_, localTangent_.data() + b * largest_ * largest_});
 }
 
 void Assembler::clear(bool tangent) {
@@ -104,18 +106,20 @@ void Assembler::clear(bool tangent) {
 void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
                         const Pass& pass) {
   assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
-  if (pass.withResidual) {
-    const int rowOffset = pass.block / stages_ * size_;
-    for (int i = 0; i < local.n; ++i) {
-      residual_[dofs[i] + rowOffset] += pass.weight * local.r[i];
-      if (!std::isfinite(local.r[i]) && firstNonFinite_.component < 0)
-        firstNonFinite_ = {static_cast<int>(component), dofs[i]};
-    }
-  }
+  if (pass.withResidual) scatterResidual(component, dofs, local.r, pass.block / stages_, pass.weight);
   if (!pass.withTangent) return;
   double* values = tangent_.valuePtr();
   for (const auto& [localEntry, value] : scatterMap_[component * stages_ * stages_ + pass.block])
     values[value] += pass.weight * local.k[localEntry];
+}
+
+void Assembler::scatterResidual(std::size_t component, const std::vector<int>& dofs, const double* r, int stage,
+                                double weight) {
+  const int rowOffset = stage * size_;
+  for (std::size_t i = 0; i < dofs.size(); ++i) {
+    residual_[dofs[i] + rowOffset] += weight * r[i];
+    if (!std::isfinite(r[i]) && firstNonFinite_.component < 0) firstNonFinite_ = {static_cast<int>(component), dofs[i]};
+  }
 }
 
 void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate,
@@ -141,8 +145,10 @@ void Assembler::replaceRow(std::size_t k, const PrescribedMotion& p, double valu
 }
 
 void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
-  // the rate form at the stages, or a component's own energy-consistent stage form
+  // the rate form at the stages, or a component's own energy-consistent stage form; a residual
+  // alone comes from addStagesTogether for the components that evaluate their stages together
   auto evaluate = [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) {
+    if (!args.tangent && c.evaluatesStagesTogether()) return;
     if (c.stageForm() == Component::StageForm::Own)
       c.stageLocal(args, w, l, f);
     else
@@ -157,6 +163,33 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
           {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent},
           evaluate);
     }
+  if (!args.tangent) addStagesTogether(model, ws, args);
+}
+
+void Assembler::addStagesTogether(const Model& model, Workspace& ws, const StageArgs& args) {
+  const auto& components = model.components();
+  for (std::size_t first = 0; first < together_.size(); first += kBatch) {
+    const int count = static_cast<int>(std::min<std::size_t>(kBatch, together_.size() - first));
+    forEachSlot(count, [&](int b) {
+      const Component& component = *components[together_[first + b]];
+      LocalSystem out[CollocationRule::kMostStages];
+      for (int l = 0; l < stages_; ++l) {
+        out[l] = {static_cast<int>(component.dofs().size()), locals_[b].r + l * largest_, locals_[b].k};
+        std::fill_n(out[l].r, out[l].n, 0.0);
+        localFlows_[b * stages_ + l] = Flows{};
+      }
+      component.stageResiduals(args, ws, out, &localFlows_[b * stages_]);
+    });
+    for (int b = 0; b < count; ++b) {
+      const std::size_t c = together_[first + b];
+      for (int l = 0; l < stages_; ++l) {
+        scatterResidual(c, components[c]->dofs(), locals_[b].r + l * largest_, l, 1.0);
+        const Flows flows = localFlows_[b * stages_ + l] * args.rule->weight[l];
+        flows_ += flows;
+        if (keepComponentFlows_) componentFlows_[c] += flows;
+      }
+    }
+  }
 }
 
 void Assembler::imposeStageMotions(const Model& model, const StageArgs& args) {

@@ -53,7 +53,7 @@ class Assembler {
   }
   // Add every stage's residual (its flows weighted b_l) and the tangent blocks of all pairs
   // of stages: one evaluation of every component per pair; without args.tangent one per stage,
-  // for the residual alone.
+  // for the residual alone (one for all stages of a component that evaluates them together).
   void addStages(const Model& model, Workspace& ws, StageArgs args);
   // Prescribed motions at every stage: v_l = V'(t_l) or the temperature, tangent 1.
   void imposeStageMotions(const Model& model, const StageArgs& args);
@@ -92,14 +92,7 @@ class Assembler {
         localFlows_[b] = Flows{};
         evaluate(*components[first + b], ws, local, localFlows_[b]);
       };
-      // a small batch, or a single thread, stays outside OpenMP altogether: a region that runs
-      // on one thread allocates its team at every entry (libgomp keeps only larger teams)
-      if (count >= kSmallestParallelBatch && omp_get_max_threads() > 1) {
-#pragma omp parallel for schedule(static)
-        for (int b = 0; b < count; ++b) evaluateSlot(b);
-      } else {
-        for (int b = 0; b < count; ++b) evaluateSlot(b);
-      }
+      forEachSlot(count, evaluateSlot);
       for (int b = 0; b < count; ++b) {
         scatter(first + b, components[first + b]->dofs(), locals_[b], pass);
         if (!pass.withResidual) continue;
@@ -108,6 +101,21 @@ class Assembler {
       }
     }
   }
+
+  // evaluate(b) for the slots b < count of a batch, in parallel when that pays
+  template <class EvaluateSlot>
+  static void forEachSlot(int count, const EvaluateSlot& evaluateSlot) {
+    // a small batch, or a single thread, stays outside OpenMP altogether: a region that runs
+    // on one thread allocates its team at every entry (libgomp keeps only larger teams)
+    if (count >= kSmallestParallelBatch && omp_get_max_threads() > 1) {
+#pragma omp parallel for schedule(static)
+      for (int b = 0; b < count; ++b) evaluateSlot(b);
+    } else {
+      for (int b = 0; b < count; ++b) evaluateSlot(b);
+    }
+  }
+  // The residuals of all stages of the components that evaluate their stages together.
+  void addStagesTogether(const Model& model, Workspace& ws, const StageArgs& args);
 
  public:
   const Eigen::VectorXd& residual() const { return residual_; }
@@ -144,6 +152,8 @@ class Assembler {
   void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate,
                   int stage = 0, double weight = 1.0);
   void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, const Pass& pass);
+  // Add weight r (the component's local residual) to the rows of `dofs` at stage `stage`.
+  void scatterResidual(std::size_t component, const std::vector<int>& dofs, const double* r, int stage, double weight);
 
   NonFiniteEntry firstNonFinite_;
   Eigen::VectorXd residual_;
@@ -173,7 +183,11 @@ class Assembler {
   static constexpr std::size_t kBatch = 256;
   static constexpr int kSmallestParallelBatch = 32;
   std::size_t firstCoupling_ = 0;
-  // one local system per batch slot, over buffers sized for the largest component
+  // the components that evaluate their stages together (Component::evaluatesStagesTogether)
+  std::vector<std::size_t> together_;
+  // one local system per batch slot, over buffers sized for the largest component (a slot's
+  // residual buffer holds one residual per stage, its flows one per stage)
+  std::size_t largest_ = 0;
   std::vector<LocalSystem> locals_;
   std::vector<Flows> localFlows_;
   std::vector<double> localResidual_;

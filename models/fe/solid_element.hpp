@@ -65,6 +65,9 @@ class SolidElement final : public Component {
   // eem4 (models/fe/solid_element_stages.cpp)
   StageForm stageForm() const override { return StageForm::Own; }
   void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // a cell's stages share its points' paths: all stages' residuals are computed together
+  bool evaluatesStagesTogether() const override { return true; }
+  void stageResiduals(const StageArgs& args, Workspace& ws, LocalSystem* out, Flows* flows) const override;
 
   // Cauchy stress and viscous strain averaged over the quadrature points (for output).
   Mat3 meanCauchyStress(const double* z) const;
@@ -97,6 +100,12 @@ class SolidElement final : public Component {
   // Mark the evaluation of an inadmissible state (an inverted cell, a non-positive stage
   // temperature) with a non-finite residual.
   static void rejectInadmissible(LocalSystem& out);
+  // eem4: stages [firstStage, firstStage + count) into out[k] and flows[k], from each point's path
+  // through all stages (a tangent for one stage at a time)
+  void addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out, Flows* flows) const;
+  struct StagePoint;
+  void addStagePoint(const StageArgs& args, int stage, const StagePoint& point, const NodalThermalVariable::Stage* node,
+                     LocalSystem& out, Flows& flows) const;
   // Add the point's residual rows and tangent columns; materialIncrement(dC) is the change
   // of the hyperelastic (and coupling) stress for a change dC of the end point's C.
   template <class MaterialIncrement>

@@ -96,30 +96,31 @@ PathChange pathChange(const PointPath& path, const CollocationRule& rule, int co
   return change;
 }
 
-// An energy of C along a point's path (W, or the coupling's L) and its stage gradient at stage l;
-// with `tangent`, also what change() needs.
+// An energy of C along a point's path (W, or the coupling's L) and its stage gradients; with a
+// tangent column (the stage whose values the tangent differentiates by, -1 for the residual
+// alone), also what change() needs.
 class StrainEnergyPath {
  public:
-  StrainEnergyPath(const HyperelasticMaterial& law, const PointPath& path, const CollocationRule& rule, int stage,
-                   int column, bool tangent)
-      : law_(law), path_(path), rule_(rule), stage_(stage), column_(column) {
+  StrainEnergyPath(const HyperelasticMaterial& law, const PointPath& path, const CollocationRule& rule, int column)
+      : law_(law), path_(path), rule_(rule), column_(column) {
     double defect = law.energyDifference(path.C0, path.CEnd);
     for (int j = 0; j < rule.stages; ++j) {
       stress_[j] = law.stress(path.C[j]);
       defect -= rule.weight[j] * 0.5 * contract(stress_[j], path.strainRate[j]);
     }
     correction_ = correction(defect, path.norm);
-    gradient_ = stress_[stage] + 2.0 * correction_.coefficient * path.strainRate[stage];
-    if (!tangent) return;
+    for (int j = 0; j < rule.stages; ++j)
+      gradient_[j] = stress_[j] + 2.0 * correction_.coefficient * path.strainRate[j];
+    if (column < 0) return;
     stressEnd_ = law.stress(path.CEnd);
     columnTangent_ = law.stressIncrement(path.C[column], path.strainRate[column]);
   }
-  const Mat3& gradient() const { return gradient_; }
+  const Mat3& gradient(int stage) const { return gradient_[stage]; }
 
-  // The change of S~_l: through mu (every stage's C', C_end and the column stage's stress) and,
-  // on the own stage, through S(C_l). In mu's derivative the material tangent enters only as
-  // dS(C_k)[C'_k] (its major symmetry: dS_k[dC_k] : C'_k = dC_k : dS_k[C'_k]).
-  Mat3 change(const PathChange& d) const {
+  // The change of S~_l at stage l: through mu (every stage's C', C_end and the column stage's
+  // stress) and, on the column's own stage, through S(C_l). In mu's derivative the material
+  // tangent enters only as dS(C_k)[C'_k] (its major symmetry: dS_k[dC_k] : C'_k = dC_k : dS_k[C'_k]).
+  Mat3 change(const PathChange& d, int stage) const {
     double dDefect = 0.5 * contract(stressEnd_, d.endStrain);
     for (int j = 0; j < rule_.stages; ++j) {
       double dPower = contract(stress_[j], d.strainRate[j]);
@@ -127,8 +128,8 @@ class StrainEnergyPath {
       dDefect -= rule_.weight[j] * 0.5 * dPower;
     }
     const double dMu = (dDefect - correction_.coefficient * correction_.normSlope * d.norm) / correction_.norm;
-    Mat3 dGradient = 2.0 * dMu * path_.strainRate[stage_] + 2.0 * correction_.coefficient * d.strainRate[stage_];
-    if (stage_ == column_) dGradient += law_.stressIncrement(path_.C[stage_], d.ownStrain);
+    Mat3 dGradient = 2.0 * dMu * path_.strainRate[stage] + 2.0 * correction_.coefficient * d.strainRate[stage];
+    if (stage == column_) dGradient += law_.stressIncrement(path_.C[stage], d.ownStrain);
     return dGradient;
   }
 
@@ -136,18 +137,19 @@ class StrainEnergyPath {
   const HyperelasticMaterial& law_;
   const PointPath& path_;
   const CollocationRule& rule_;
-  int stage_, column_;
-  Mat3 stress_[kStages], stressEnd_, columnTangent_, gradient_;
+  int column_;
+  Mat3 stress_[kStages], gradient_[kStages], stressEnd_, columnTangent_;
   Correction correction_{};
 };
 
-// The Maxwell branch's energy along A = E - Gamma and its stage gradient D Psi_l at stage l.
+// The Maxwell branch's energy along A = E - Gamma and its stage gradients D Psi_l.
 class BranchPath {
  public:
-  // (gamma: the viscous strain at the start and at each stage; gammaRate: its tau-rates)
+  // (gamma: the viscous strain at the start and at each stage; gammaRate: its tau-rates; column
+  // as for StrainEnergyPath)
   BranchPath(const ViscousBranch& branch, const PointPath& path, const Mat3 (&gamma)[kStages + 1],
-             const Mat3 (&gammaRate)[kStages], const Mat3& gammaEnd, const CollocationRule& rule, int stage, int column)
-      : branch_(branch), rule_(rule), stage_(stage), column_(column) {
+             const Mat3 (&gammaRate)[kStages], const Mat3& gammaEnd, const CollocationRule& rule, int column)
+      : branch_(branch), rule_(rule), column_(column) {
     const Mat3 A0 = greenStrain(path.C0) - gamma[0], AEnd = greenStrain(path.CEnd) - gammaEnd;
     stressEnd_ = branchStressOf(branch, AEnd);
     // Psi_v is quadratic in A: its change is exact from the mean stress
@@ -160,13 +162,13 @@ class BranchPath {
       norm += rule.weight[j] * contract(rate_[j], rate_[j]);
     }
     correction_ = correction(defect, norm);
-    gradient_ = stress_[stage] + correction_.coefficient * rate_[stage];
+    for (int j = 0; j < rule.stages; ++j) gradient_[j] = stress_[j] + correction_.coefficient * rate_[j];
   }
-  const Mat3& gradient() const { return gradient_; }
+  const Mat3& gradient(int stage) const { return gradient_[stage]; }
 
-  // The change of D Psi_l for a change d of the positions' path and dGamma of stage column's
-  // viscous strain (S_v is linear and symmetric: S_v(dA_j) : A'_j = dA_j : S_v(A'_j)).
-  Mat3 change(const PathChange& d, const Mat3& dGamma) const {
+  // The change of D Psi_l at stage l for a change d of the positions' path and dGamma of the
+  // column stage's viscous strain (S_v is linear and symmetric: S_v(dA_j) : A'_j = dA_j : S_v(A'_j)).
+  Mat3 change(const PathChange& d, const Mat3& dGamma, int stage) const {
     double dDefect = contract(stressEnd_, 0.5 * d.endStrain - rule_.end[column_ + 1] * dGamma), dNorm = 0.0;
     Mat3 dRateOwn = Mat3::Zero();
     const Mat3 dAOwn = 0.5 * d.ownStrain - dGamma;
@@ -176,27 +178,157 @@ class BranchPath {
       if (j == column_) dPower += contract(dAOwn, branchStressOf(branch_, rate_[j]));
       dDefect -= rule_.weight[j] * dPower;
       dNorm += 2.0 * rule_.weight[j] * contract(rate_[j], dRate);
-      if (j == stage_) dRateOwn = dRate;
+      if (j == stage) dRateOwn = dRate;
     }
     const double dNu = (dDefect - correction_.coefficient * correction_.normSlope * dNorm) / correction_.norm;
-    Mat3 dGradient = dNu * rate_[stage_] + correction_.coefficient * dRateOwn;
-    if (stage_ == column_) dGradient += branchStressOf(branch_, dAOwn);
+    Mat3 dGradient = dNu * rate_[stage] + correction_.coefficient * dRateOwn;
+    if (stage == column_) dGradient += branchStressOf(branch_, dAOwn);
     return dGradient;
   }
 
  private:
   const ViscousBranch& branch_;
   const CollocationRule& rule_;
-  int stage_, column_;
-  Mat3 A_[kStages], rate_[kStages], stress_[kStages], stressEnd_, gradient_;
+  int column_;
+  Mat3 A_[kStages], rate_[kStages], stress_[kStages], gradient_[kStages], stressEnd_;
   Correction correction_{};
 };
 }  // namespace
 
-void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+// A quadrature point's path through the stages and its energies' stage gradients (the
+// coupling's in a thermal cell, the branch's in a viscous one).
+struct SolidElement::StagePoint {
+  int q;
+  const PointPath& path;
+  const StrainEnergyPath& elastic;
+  const StrainEnergyPath* coupling;
+  const BranchPath* branch;
+};
+
+void SolidElement::addStagePoint(const StageArgs& args, int l, const StagePoint& point,
+                                 const NodalThermalVariable::Stage* node, LocalSystem& out, Flows& flows) const {
   const CollocationRule& rule = *args.rule;
-  const int l = args.stage, column = args.column, s = rule.stages, momentumRow = 3 * nodes_;
-  const bool own = l == column;
+  const int q = point.q, column = args.column, momentumRow = 3 * nodes_, gammaRow = 6 * nodes_ + 6 * q;
+  const CellPoint& p = spec_.points[q];
+  const ShapeGradients& G = p.gradients;
+  const double w = p.weight;
+  const PointPath& path = point.path;
+  const StrainEnergyPath& elastic = point.elastic;
+  const StrainEnergyPath* coupling = point.coupling;
+  const BranchPath* branch = point.branch;
+  auto r = out.residual();
+  auto K = out.tangent();
+  Mat3 totalStress = elastic.gradient(l);
+
+  // a thermal point: its stage temperature and the coupling's stage gradient, whose power is
+  // the rate of the coupling entropy
+  double temperature = 0.0, shift = 0.0, entropyRate = 0.0;
+  ShapeValues temperatureSlope = ShapeValues::Zero();
+  if (coupling) {
+    for (int a = 0; a < nodes_; ++a) {
+      temperature += p.values[a] * node[a].temperature.value;
+      temperatureSlope[a] = p.values[a] * node[a].temperature.slope;
+    }
+    shift = spec_.thermal->referenceTemperature - temperature;
+    totalStress += shift * coupling->gradient(l);
+    entropyRate = 0.5 * contract(coupling->gradient(l), path.strainRate[l]) / args.dt;
+  }
+
+  // the branch: Gamma' = D Psi_l / eta at the stage; its dissipation leaves a mechanical cell
+  // and heats a thermal cell's nodes
+  const Fluidity fluidity = fluidityAt(temperature);
+  double heating = 0.0;
+  if (branch) {
+    const Mat3& branchStress = branch->gradient(l);
+    totalStress += branchStress;
+    for (int k = 0; k < 6; ++k) {
+      const auto [i, j] = kComponent[k];
+      r[gammaRow + k] = args.stageRate[l][spec_.firstInternalDof + 6 * q + k] - fluidity.value * branchStress(i, j);
+    }
+    heating = w * fluidity.value * contract(branchStress, branchStress);
+    if (!coupling) flows.dissipated += heating;
+  }
+
+  // nodal forces w F_l (S~_l + D Psi_l + shift S~L_l) dN_a/dX; heat rows T_a,l w N_a L' - N_a heating
+  const Mat3 firstPiola = w * path.F[l] * totalStress;
+  for (int a = 0; a < nodes_; ++a) r.segment<3>(momentumRow + 3 * a) += firstPiola * G.row(a).transpose();
+  if (coupling)
+    for (int a = 0; a < nodes_; ++a)
+      r[firstThermal_ + a] += node[a].temperature.value * w * p.values[a] * entropyRate - p.values[a] * heating;
+  if (!args.tangent) return;
+
+  // A position or viscous-strain column of stage `column`: the positions move F by dF (the
+  // path by d), the viscous strain by dGamma.
+  auto addColumn = [&](int localColumn, const Mat3& dF, const PathChange& d, const Mat3& dGamma, bool moves) {
+    Mat3 dStress = moves ? elastic.change(d, l) : Mat3::Zero();
+    Mat3 dBranch = Mat3::Zero();
+    if (branch) {
+      dBranch = branch->change(d, dGamma, l);
+      dStress += dBranch;
+      for (int k = 0; k < 6; ++k)
+        K(gammaRow + k, localColumn) -= fluidity.value * dBranch(kComponent[k][0], kComponent[k][1]);
+    }
+    if (coupling) {
+      const Mat3 dCoupling = moves ? coupling->change(d, l) : Mat3::Zero();
+      dStress += shift * dCoupling;
+      const double dEntropyRate =
+          0.5 * (contract(dCoupling, path.strainRate[l]) + contract(coupling->gradient(l), d.strainRate[l])) / args.dt;
+      const double dHeating = branch ? 2.0 * w * fluidity.value * contract(branch->gradient(l), dBranch) : 0.0;
+      for (int a = 0; a < nodes_; ++a)
+        K(firstThermal_ + a, localColumn) +=
+            node[a].temperature.value * w * p.values[a] * dEntropyRate - p.values[a] * dHeating;
+    }
+    Mat3 dPiola = w * path.F[l] * dStress;
+    if (l == column) dPiola += w * dF * totalStress;
+    for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, localColumn) += dPiola * G.row(a).transpose();
+  };
+  for (int b = 0; b < nodes_; ++b)
+    for (int i = 0; i < 3; ++i) {
+      Mat3 dF = Mat3::Zero();
+      dF.row(i) = G.row(b);
+      addColumn(3 * b + i, dF, pathChange(path, rule, column, dF), Mat3::Zero(), true);
+    }
+  if (branch)
+    for (int m = 0; m < 6; ++m) {
+      Mat3 dGamma = Mat3::Zero();
+      dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
+      addColumn(gammaRow + m, Mat3::Zero(), PathChange{}, dGamma, false);
+      // the viscous strain's own rate
+      K(gammaRow + m, gammaRow + m) += rule.rate[l][column + 1] / args.dt;
+    }
+  if (!coupling) return;
+
+  // A temperature column of stage `column`: T_b,l moves the point's temperature, and with it
+  // the coupling stress, the fluidity and the heating, and weights node b's row.
+  for (int b = 0; b < nodes_; ++b) {
+    const int thermalColumn = firstThermal_ + b;
+    const double dTemperature = temperatureSlope[b];
+    const Mat3 dPiola = -dTemperature * w * path.F[l] * coupling->gradient(l);
+    for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, thermalColumn) += dPiola * G.row(a).transpose();
+    K(thermalColumn, thermalColumn) += node[b].temperature.slope * w * p.values[b] * entropyRate;
+    if (!branch) continue;
+    const double dFluidity = fluidity.slope * dTemperature;
+    for (int k = 0; k < 6; ++k)
+      K(gammaRow + k, thermalColumn) -= dFluidity * branch->gradient(l)(kComponent[k][0], kComponent[k][1]);
+    const double dHeating = w * dFluidity * contract(branch->gradient(l), branch->gradient(l));
+    for (int a = 0; a < nodes_; ++a) K(firstThermal_ + a, thermalColumn) -= p.values[a] * dHeating;
+  }
+}
+
+void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows& flows) const {
+  addStages(args, args.stage, 1, &out, &flows);
+}
+
+void SolidElement::stageResiduals(const StageArgs& args, Workspace&, LocalSystem* out, Flows* flows) const {
+  addStages(args, 0, args.rule->stages, out, flows);
+}
+
+void SolidElement::addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out, Flows* flows) const {
+  const CollocationRule& rule = *args.rule;
+  const int s = rule.stages, column = args.tangent ? args.column : -1;
+  auto reject = [&] {
+    for (int k = 0; k < count; ++k) rejectInadmissible(out[k]);
+  };
   // node positions at the basis points of the stage polynomial (the start, then each stage)
   CellPositions basis[kStages + 1], xRate[kStages];
   basis[0] = positions(args.zOld);
@@ -205,47 +337,29 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
     xRate[j] = args.dt * positions(args.stageRate[j]);
   }
   const CellPositions xEnd = positions(args.zEnd);
-  // a thermal cell's nodes at the stage: T_a,l, the capacity's energy rate, their derivatives
-  NodalThermalVariable::Stage node[kMaxCellNodes];
+  // a thermal cell's nodes at each stage: T_a,l, the capacity's energy rate, their derivatives
+  NodalThermalVariable::Stage node[kStages][kMaxCellNodes];
   if (spec_.thermal)
-    for (int a = 0; a < nodes_; ++a) {
-      node[a] = spec_.thermalVariable.stage(args, spec_.thermalDofs[a]);
-      const double T = node[a].temperature.value;
-      if (!(std::isfinite(T) && T > 0.0)) return rejectInadmissible(out);
-    }
-  auto r = out.residual();
-  auto K = out.tangent();
-  for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
-    const CellPoint& p = spec_.points[q];
-    const ShapeGradients& G = p.gradients;
-    const double w = p.weight;
-    const PointPath path = pointPath(basis, xRate, xEnd, G, rule);
-    if (!(path.F[l].determinant() > 0.0) || !(path.FEnd.determinant() > 0.0)) return rejectInadmissible(out);
-    const StrainEnergyPath elastic(*spec_.material, path, rule, l, column, args.tangent);
-    Mat3 totalStress = elastic.gradient();
-
-    // a thermal point: its stage temperature and the coupling's stage gradient, whose power is
-    // the rate of the coupling entropy
-    std::optional<StrainEnergyPath> coupling;
-    double temperature = 0.0, shift = 0.0, entropyRate = 0.0;
-    ShapeValues temperatureSlope = ShapeValues::Zero();
-    if (spec_.thermal) {
-      coupling.emplace(*coupling_, path, rule, l, column, args.tangent);
+    for (int k = 0; k < count; ++k) {
+      StageArgs atStage = args;
+      atStage.stage = firstStage + k;
+      if (!args.tangent) atStage.column = atStage.stage;
       for (int a = 0; a < nodes_; ++a) {
-        temperature += p.values[a] * node[a].temperature.value;
-        temperatureSlope[a] = p.values[a] * node[a].temperature.slope;
+        node[k][a] = spec_.thermalVariable.stage(atStage, spec_.thermalDofs[a]);
+        const double T = node[k][a].temperature.value;
+        if (!(std::isfinite(T) && T > 0.0)) return reject();
       }
-      shift = spec_.thermal->referenceTemperature - temperature;
-      totalStress += shift * coupling->gradient();
-      entropyRate = 0.5 * contract(coupling->gradient(), path.strainRate[l]) / args.dt;
     }
-
-    // the branch: Gamma' = D Psi_l / eta at the stage; its dissipation leaves a mechanical cell
-    // and heats a thermal cell's nodes
+  for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
+    // the point's path through all stages, and its energies' stage gradients, serve every stage
+    const PointPath path = pointPath(basis, xRate, xEnd, spec_.points[q].gradients, rule);
+    if (!(path.FEnd.determinant() > 0.0)) return reject();
+    for (int k = 0; k < count; ++k)
+      if (!(path.F[firstStage + k].determinant() > 0.0)) return reject();
+    const StrainEnergyPath elastic(*spec_.material, path, rule, column);
+    std::optional<StrainEnergyPath> coupling;
+    if (spec_.thermal) coupling.emplace(*coupling_, path, rule, column);
     std::optional<BranchPath> branch;
-    const Fluidity fluidity = fluidityAt(temperature);
-    double heating = 0.0;
-    const int gammaRow = 6 * nodes_ + 6 * q;
     if (spec_.branch) {
       Mat3 gamma[kStages + 1], gammaRate[kStages];
       gamma[0] = viscousStrain(args.zOld, q);
@@ -253,91 +367,21 @@ void SolidElement::stageLocal(const StageArgs& args, Workspace&, LocalSystem& ou
         gamma[j + 1] = viscousStrain(args.stageState[j], q);
         gammaRate[j] = args.dt * viscousStrain(args.stageRate[j], q);
       }
-      branch.emplace(*spec_.branch, path, gamma, gammaRate, viscousStrain(args.zEnd, q), rule, l, column);
-      totalStress += branch->gradient();
-      for (int k = 0; k < 6; ++k) {
-        const auto [i, j] = kComponent[k];
-        r[gammaRow + k] =
-            args.stageRate[l][spec_.firstInternalDof + 6 * q + k] - fluidity.value * branch->gradient()(i, j);
-      }
-      heating = w * fluidity.value * contract(branch->gradient(), branch->gradient());
-      if (!spec_.thermal) flows.dissipated += heating;
+      branch.emplace(*spec_.branch, path, gamma, gammaRate, viscousStrain(args.zEnd, q), rule, column);
     }
-
-    // nodal forces w F_l (S~_l + D Psi_l + shift S~L_l) dN_a/dX; heat rows T_a,l w N_a L' - N_a heating
-    const Mat3 firstPiola = w * path.F[l] * totalStress;
-    for (int a = 0; a < nodes_; ++a) r.segment<3>(momentumRow + 3 * a) += firstPiola * G.row(a).transpose();
-    if (spec_.thermal)
-      for (int a = 0; a < nodes_; ++a)
-        r[firstThermal_ + a] += node[a].temperature.value * w * p.values[a] * entropyRate - p.values[a] * heating;
-    if (!args.tangent) continue;
-
-    // A position or viscous-strain column of stage `column`: the positions move F by dF (the
-    // path by d), the viscous strain by dGamma.
-    auto addColumn = [&](int localColumn, const Mat3& dF, const PathChange& d, const Mat3& dGamma, bool moves) {
-      Mat3 dStress = moves ? elastic.change(d) : Mat3::Zero();
-      Mat3 dBranch = Mat3::Zero();
-      if (branch) {
-        dBranch = branch->change(d, dGamma);
-        dStress += dBranch;
-        for (int k = 0; k < 6; ++k)
-          K(gammaRow + k, localColumn) -= fluidity.value * dBranch(kComponent[k][0], kComponent[k][1]);
-      }
-      if (coupling) {
-        const Mat3 dCoupling = moves ? coupling->change(d) : Mat3::Zero();
-        dStress += shift * dCoupling;
-        const double dEntropyRate =
-            0.5 * (contract(dCoupling, path.strainRate[l]) + contract(coupling->gradient(), d.strainRate[l])) / args.dt;
-        const double dHeating = branch ? 2.0 * w * fluidity.value * contract(branch->gradient(), dBranch) : 0.0;
-        for (int a = 0; a < nodes_; ++a)
-          K(firstThermal_ + a, localColumn) +=
-              node[a].temperature.value * w * p.values[a] * dEntropyRate - p.values[a] * dHeating;
-      }
-      Mat3 dPiola = w * path.F[l] * dStress;
-      if (own) dPiola += w * dF * totalStress;
-      for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, localColumn) += dPiola * G.row(a).transpose();
-    };
-    for (int b = 0; b < nodes_; ++b)
-      for (int i = 0; i < 3; ++i) {
-        Mat3 dF = Mat3::Zero();
-        dF.row(i) = G.row(b);
-        addColumn(3 * b + i, dF, pathChange(path, rule, column, dF), Mat3::Zero(), true);
-      }
-    if (branch)
-      for (int m = 0; m < 6; ++m) {
-        Mat3 dGamma = Mat3::Zero();
-        dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
-        addColumn(gammaRow + m, Mat3::Zero(), PathChange{}, dGamma, false);
-        // the viscous strain's own rate
-        K(gammaRow + m, gammaRow + m) += rule.rate[l][column + 1] / args.dt;
-      }
-    if (!spec_.thermal) continue;
-
-    // A temperature column of stage `column`: T_b,l moves the point's temperature, and with it
-    // the coupling stress, the fluidity and the heating, and weights node b's row.
-    for (int b = 0; b < nodes_; ++b) {
-      const int thermalColumn = firstThermal_ + b;
-      const double dTemperature = temperatureSlope[b];
-      const Mat3 dPiola = -dTemperature * w * path.F[l] * coupling->gradient();
-      for (int a = 0; a < nodes_; ++a)
-        K.block<3, 1>(momentumRow + 3 * a, thermalColumn) += dPiola * G.row(a).transpose();
-      K(thermalColumn, thermalColumn) += node[b].temperature.slope * w * p.values[b] * entropyRate;
-      if (!branch) continue;
-      const double dFluidity = fluidity.slope * dTemperature;
-      for (int k = 0; k < 6; ++k)
-        K(gammaRow + k, thermalColumn) -= dFluidity * branch->gradient()(kComponent[k][0], kComponent[k][1]);
-      const double dHeating = w * dFluidity * contract(branch->gradient(), branch->gradient());
-      for (int a = 0; a < nodes_; ++a) K(firstThermal_ + a, thermalColumn) -= p.values[a] * dHeating;
-    }
+    const StagePoint point{q, path, elastic, coupling ? &*coupling : nullptr, branch ? &*branch : nullptr};
+    for (int k = 0; k < count; ++k) addStagePoint(args, firstStage + k, point, node[k], out[k], flows[k]);
   }
   // the heat capacity, lumped at the nodes: m_a D_s e s'_l
   if (!spec_.thermal) return;
-  ShapeValues rates = ShapeValues::Zero(), slopes = ShapeValues::Zero();
-  for (int a = 0; a < nodes_; ++a) {
-    rates[a] = node[a].energyRate.value;
-    slopes[a] = node[a].energyRate.slope;
+  for (int k = 0; k < count; ++k) {
+    ShapeValues rates = ShapeValues::Zero(), slopes = ShapeValues::Zero();
+    for (int a = 0; a < nodes_; ++a) {
+      rates[a] = node[k][a].energyRate.value;
+      slopes[a] = node[k][a].energyRate.slope;
+    }
+    addHeatCapacity(rates, slopes, out[k]);
   }
-  addHeatCapacity(rates, slopes, out);
 }
 
 }  // namespace mpx
