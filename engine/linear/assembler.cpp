@@ -80,11 +80,12 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
       for (int m = 0; m < stages; ++m)
         prescribedEndEntries_.push_back(findEntry(tangent_, p.dof + (stages - 1) * n, p.dof + m * n));
   const auto& components = model.components();
-  firstCoupling_ = std::partition_point(components.begin(), components.end(),
-                                        [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); }) -
-                   components.begin();
-  for (std::size_t c = 0; c < components.size(); ++c)
-    if (stages > 1 && components[c]->evaluatesStagesTogether()) together_.push_back(c);
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    const bool together = stages > 1 && components[c]->evaluatesStagesTogether();
+    if (together) together_.push_back(c);
+    (components[c]->isCoupling() ? everyComponent_.couplings : everyComponent_.owners).push_back(c);
+    if (!together) (components[c]->isCoupling() ? stageByStage_.couplings : stageByStage_.owners).push_back(c);
+  }
   for (const auto& component : components) largest_ = std::max(largest_, component->dofs().size());
   const std::size_t slots = std::min(kBatch, components.size());
   localResidual_.assign(slots * stages * largest_, 0.0);
@@ -148,7 +149,6 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
   // the rate form at the stages, or a component's own energy-consistent stage form; a residual
   // alone comes from addStagesTogether for the components that evaluate their stages together
   auto evaluate = [&](const Component& c, Workspace& w, LocalSystem& l, Flows& f) {
-    if (!args.tangent && c.evaluatesStagesTogether()) return;
     if (c.stageForm() == Component::StageForm::Own)
       c.stageLocal(args, w, l, f);
     else
@@ -160,8 +160,8 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
     for (int offset = 0; offset < columnPasses; ++offset) {
       args.column = (args.stage + offset) % stages_;
       add(model, ws,
-          {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent},
-          evaluate);
+          {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent}, evaluate,
+          args.tangent ? everyComponent_ : stageByStage_);
     }
   if (!args.tangent) addStagesTogether(model, ws, args);
 }

@@ -69,35 +69,45 @@ class Assembler {
     bool withResidual;
     bool withTangent;
   };
-  // Evaluate every component with evaluate(component, workspace, local, flows) and add the
-  // result as `pass` says.
+  // The components one pass evaluates, in model order: owners first, then couplings, which
+  // read the node temperatures their owners publish (so the two never share a batch).
+  struct PassOrder {
+    std::vector<std::size_t> owners;
+    std::vector<std::size_t> couplings;
+  };
+  // Evaluate the components of `order` with evaluate(component, workspace, local, flows) and
+  // add the result as `pass` says.
   template <class Evaluate>
-  void add(const Model& model, Workspace& ws, const Pass& pass, const Evaluate& evaluate) {
-    // couplings read the node temperatures their owners publish: all owners come first
-    addRange(model, 0, firstCoupling_, ws, pass, evaluate);
-    addRange(model, firstCoupling_, model.components().size(), ws, pass, evaluate);
+  void add(const Model& model, Workspace& ws, const Pass& pass, const Evaluate& evaluate, const PassOrder& order) {
+    addBatches(model, order.owners, ws, pass, evaluate);
+    addBatches(model, order.couplings, ws, pass, evaluate);
   }
   template <class Evaluate>
-  void addRange(const Model& model, std::size_t begin, std::size_t end, Workspace& ws, const Pass& pass,
-                const Evaluate& evaluate) {
+  void add(const Model& model, Workspace& ws, const Pass& pass, const Evaluate& evaluate) {
+    add(model, ws, pass, evaluate, everyComponent_);
+  }
+  template <class Evaluate>
+  void addBatches(const Model& model, const std::vector<std::size_t>& indices, Workspace& ws, const Pass& pass,
+                  const Evaluate& evaluate) {
     const auto& components = model.components();
-    for (std::size_t first = begin; first < end; first += kBatch) {
-      const int count = static_cast<int>(std::min<std::size_t>(kBatch, end - first));
+    for (std::size_t first = 0; first < indices.size(); first += kBatch) {
+      const int count = static_cast<int>(std::min<std::size_t>(kBatch, indices.size() - first));
+      const std::size_t* batch = indices.data() + first;
       auto evaluateSlot = [&](int b) {
         LocalSystem& local = locals_[b];
-        local.n = static_cast<int>(components[first + b]->dofs().size());
+        local.n = static_cast<int>(components[batch[b]]->dofs().size());
         std::fill_n(local.r, local.n, 0.0);
         // a residual-only pass leaves what a component writes into its tangent there, unread
         if (pass.withTangent) std::fill_n(local.k, local.n * local.n, 0.0);
         localFlows_[b] = Flows{};
-        evaluate(*components[first + b], ws, local, localFlows_[b]);
+        evaluate(*components[batch[b]], ws, local, localFlows_[b]);
       };
       forEachSlot(count, evaluateSlot);
       for (int b = 0; b < count; ++b) {
-        scatter(first + b, components[first + b]->dofs(), locals_[b], pass);
+        scatter(batch[b], components[batch[b]]->dofs(), locals_[b], pass);
         if (!pass.withResidual) continue;
         flows_ += localFlows_[b] * pass.flowWeight;
-        if (keepComponentFlows_) componentFlows_[first + b] += localFlows_[b] * pass.flowWeight;
+        if (keepComponentFlows_) componentFlows_[batch[b]] += localFlows_[b] * pass.flowWeight;
       }
     }
   }
@@ -182,9 +192,11 @@ class Assembler {
   // threads costs more than they save: docs/performance.md, "Parallel assembly").
   static constexpr std::size_t kBatch = 256;
   static constexpr int kSmallestParallelBatch = 32;
-  std::size_t firstCoupling_ = 0;
-  // the components that evaluate their stages together (Component::evaluatesStagesTogether)
+  PassOrder everyComponent_;
+  // the components that evaluate their stages together (Component::evaluatesStagesTogether),
+  // and the others, which a residual-only stage pass evaluates one stage at a time
   std::vector<std::size_t> together_;
+  PassOrder stageByStage_;
   // one local system per batch slot, over buffers sized for the largest component (a slot's
   // residual buffer holds one residual per stage, its flows one per stage)
   std::size_t largest_ = 0;
