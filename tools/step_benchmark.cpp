@@ -113,12 +113,14 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 // scenes/lblock_thermoelastic.xml (same elastic constants, so only the thermal part differs).
 enum class LBlockVariant { Elastic, Viscoelastic, Thermoelastic };
 // Full Newton (a factorisation per iteration), or the simplified Newton the L-block scenes of
-// scenes/ ask for (<solver reuse_contraction="0.5"/>).
-enum class LBlockNewton { Full, Simplified };
+// scenes/ ask for (<solver reuse_contraction="0.5" symmetric_factorisation="true"/>), with the
+// tangent's LU or, on large systems, the Cholesky factor of its symmetric part.
+enum class LBlockNewton { Full, Simplified, SimplifiedSymmetric };
 
 SceneSpec lblock(int level, LBlockVariant variant, double dt, LBlockNewton newton) {
   SceneSpec scene = generatedScene("lblock", dt, 50);
-  if (newton == LBlockNewton::Simplified) scene.settings.newton.reuseContraction = 0.5;
+  if (newton != LBlockNewton::Full) scene.settings.newton.reuseContraction = 0.5;
+  scene.settings.newton.symmetricFactorisation = newton == LBlockNewton::SimplifiedSymmetric;
   ElementSpec& block = scene.add("solid", {{"name", "block"},
                                            {"mesh", "lblock"},
                                            {"level", level},
@@ -347,14 +349,17 @@ void loadedSolidBenchmark(benchmark::State& state, const std::shared_ptr<LoadedS
 
 // Register the EEM step (dt 0.1) of the L-block at mesh level `level` in its loaded phase:
 // from a state at t = 1 (a fifth into the load, reached by two steps of 0.5), `steps` timed
-// steps per run; "eem" with full Newton, "eem-simplified" with simplified Newton.
+// steps per run; "eem" with full Newton, "eem-simplified" with simplified Newton, "-symmetric"
+// with the symmetric part factorised.
 void registerLBlock(const std::string& name, int level, LBlockVariant variant, int steps,
                     LBlockNewton newton = LBlockNewton::Full) {
   auto solid = std::make_shared<LoadedSolid>();
   solid->scene = std::make_shared<const CompiledScene>(compileScene(lblock(level, variant, 0.1, newton)));
   solid->loadedTime = 1.0;
   solid->loadingDt = 0.5;
-  const std::string scheme = newton == LBlockNewton::Full ? "/eem" : "/eem-simplified";
+  const std::string scheme = newton == LBlockNewton::Full         ? "/eem"
+                             : newton == LBlockNewton::Simplified ? "/eem-simplified"
+                                                                  : "/eem-simplified-symmetric";
   benchmark::RegisterBenchmark((name + "/level" + std::to_string(level) + scheme).c_str(), loadedSolidBenchmark, solid)
       ->Iterations(steps)
       ->Unit(benchmark::kMillisecond);
@@ -385,6 +390,7 @@ int main(int argc, char** argv) {
   // as scenes/lblock_elastic.xml and lblock_viscoelastic.xml run them: simplified Newton
   for (int level : {1, 4})
     registerLBlock("lblock_elastic", level, LBlockVariant::Elastic, 10, LBlockNewton::Simplified);
+  registerLBlock("lblock_elastic", 4, LBlockVariant::Elastic, 10, LBlockNewton::SimplifiedSymmetric);
   registerLBlock("lblock_viscoelastic", 1, LBlockVariant::Viscoelastic, 20, LBlockNewton::Simplified);
   registerLBlock("lblock_viscoelastic", 1, LBlockVariant::Viscoelastic, 20);
   registerLBlock("lblock_viscoelastic", 2, LBlockVariant::Viscoelastic, 10);

@@ -26,8 +26,10 @@ namespace mpx {
 
 class CondensedSolver {
  public:
-  // `pattern`: the fixed pattern of every tangent this solver will see.
-  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern);
+  // `pattern`: the fixed pattern of every tangent this solver will see. `symmetricPart`: a large
+  // condensed system is factorised by its symmetric part (an approximation, for simplified
+  // Newton only; engine/linear/cholmod_solver.hpp).
+  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern, bool symmetricPart = false);
 
   // Factorise the condensed form of `tangent` (of the pattern given at construction). Its values
   // are kept, since solve reads its kinematic rows and velocity couplings: the tangent may be
@@ -35,7 +37,7 @@ class CondensedSolver {
   // Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
   // Forget the factorisation, its pivots and analysis: the next factorize starts as the first.
-  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows())); }
+  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_); }
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Unknowns of the system actually factorised.
@@ -97,6 +99,7 @@ class CondensedSolver {
   Eigen::VectorXd reducedRhs_;
   GroupElimination internal_;
   Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
+  bool symmetricPart_;
   std::unique_ptr<SparseLu> lu_;
 };
 

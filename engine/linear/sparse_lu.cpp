@@ -1,11 +1,13 @@
 #include "engine/linear/sparse_lu.hpp"
 
+#include "engine/linear/cholmod_solver.hpp"
 #include "engine/linear/klu_solver.hpp"
 #include "engine/linear/umfpack_solver.hpp"
 
 namespace mpx {
 
-std::unique_ptr<SparseLu> makeSparseLu(int size) {
+std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart) {
+  if (size >= kLargeSystem && symmetricPart) return std::make_unique<CholmodSolver>(size);
   if (size >= kLargeSystem) return std::make_unique<UmfpackSolver>(size);
   return std::make_unique<KluSolver>();
 }

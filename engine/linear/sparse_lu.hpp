@@ -22,8 +22,9 @@ class SparseLu {
 // KLU (pivot reuse, no allocation) for small systems such as multibody and thermal networks;
 // UMFPACK with a fill-reducing ordering for the large systems of 3D solids, where KLU is
 // 20-60 times slower (docs/performance.md). A dense LU measured no faster than KLU on the
-// smallest systems (docs/performance.md, "Small systems").
-std::unique_ptr<SparseLu> makeSparseLu(int size);
+// smallest systems (docs/performance.md, "Small systems"). With `symmetricPart`, a large system
+// gets CHOLMOD on its symmetric part, an approximation for simplified Newton (cholmod_solver.hpp).
+std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false);
 // Systems of at least this many unknowns go to UMFPACK.
 inline constexpr int kLargeSystem = 3000;
 

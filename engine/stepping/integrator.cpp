@@ -25,7 +25,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       settings_(settings),
       rule_(gaussCollocation(scheme == Scheme::Eem4 ? 2 : 1)),
       assembler_(model, localForm(scheme), rule_.stages),
-      solver_(model.layout(), assembler_.tangent()),
+      solver_(model.layout(), assembler_.tangent(), settings.symmetricFactorisation && rule_.stages == 1),
       workspace_(model.makeWorkspace()),
       zMid_(model.layout().total()),
       zDot_(model.layout().total()),

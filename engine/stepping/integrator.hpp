@@ -34,6 +34,10 @@ struct NewtonSettings {
   // when they do not, when dt changes by more than a fifth or when the line search fails. The
   // iterates in between evaluate the residual alone. 0 (default): full Newton.
   double reuseContraction = 0.0;
+  // Simplified Newton of a one-stage scheme factorises the symmetric part of a large condensed
+  // tangent with CHOLMOD instead of the tangent with UMFPACK (engine/linear/cholmod_solver.hpp).
+  // eem4's stage system is far from symmetric and keeps its LU.
+  bool symmetricFactorisation = false;
   // Full Newton keeps its factorisation for the next iteration once the relative increment is
   // below this (0, the default: a fresh factorisation at every iteration). At 1e-4 the
   // iterations stay the same in number and a fifth of the factorisations go on the L-block,

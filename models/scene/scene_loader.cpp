@@ -34,6 +34,8 @@ void checkSettings(const SceneSpec& scene) {
   require(n.incrementTolerance > 0.0 && n.residualTolerance > 0.0, "Newton tolerances must be positive");
   require(n.maxIterations >= 1 && n.maxCutbacks >= 0, "max_iterations must be at least 1, max_cutbacks at least 0");
   require(n.reuseContraction >= 0.0 && n.reuseContraction < 1.0, "reuse_contraction must be in [0, 1)");
+  require(!n.symmetricFactorisation || n.reuseContraction > 0.0,
+          "symmetric_factorisation approximates the tangent: it needs simplified Newton (reuse_contraction > 0)");
   require(n.reuseBelowIncrement >= 0.0 && std::isfinite(n.reuseBelowIncrement),
           "reuse_below_increment must be finite and non-negative");
   require(scene.gravity.allFinite(), "gravity must be finite");

@@ -60,8 +60,11 @@ void readSolver(ElementReader& in, NewtonSettings& n) {
   n.predictor = in.flag("predictor", n.predictor);
   n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
   n.reuseBelowIncrement = in.nonNegative("reuse_below_increment", n.reuseBelowIncrement);
+  n.symmetricFactorisation = in.flag("symmetric_factorisation", n.symmetricFactorisation);
   if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
   if (!(n.reuseContraction < 1.0)) in.fail("reuse_contraction must be below 1 (0: full Newton)");
+  if (n.symmetricFactorisation && n.reuseContraction == 0.0)
+    in.fail("symmetric_factorisation approximates the tangent: it needs simplified Newton (reuse_contraction > 0)");
 }
 
 ConstraintSettings readConstraints(ElementReader& in) {
