@@ -7,6 +7,9 @@ namespace mpx {
 
 CholmodSolver::CholmodSolver(int size) : lu_(size) {
   cholmod_start(&common_);
+  // a supernodal LL^T, which reports a symmetric part that is not positive definite (a
+  // simplicial LDL^T would factorise an indefinite one without pivoting)
+  common_.supernodal = CHOLMOD_SUPERNODAL;
   rhs_ = cholmod_allocate_dense(size, 1, size, CHOLMOD_REAL, &common_);
 }
 

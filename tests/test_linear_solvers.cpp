@@ -1,0 +1,72 @@
+// The symmetric-part factorisation of engine/linear/cholmod_solver: it solves with
+// (A + A^T)/2 where that is positive definite, and with A itself (UMFPACK) from the first
+// matrix whose symmetric part is not.
+#include "engine/linear/cholmod_solver.hpp"
+
+#include <gtest/gtest.h>
+#include <Eigen/Dense>
+
+namespace mpx::test {
+namespace {
+
+// A non-symmetric banded matrix of size n: diagonal `diagonal`, A(i, i+1) = 1 + skew and
+// A(i+1, i) = 1 - skew, A(i, i+3) = 0.3 without a transposed partner (a one-sided pattern entry).
+Eigen::SparseMatrix<double> bandedMatrix(int n, double diagonal, double skew) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.emplace_back(i, i, diagonal + 0.01 * i);
+    if (i + 1 < n) entries.emplace_back(i, i + 1, 1.0 + skew), entries.emplace_back(i + 1, i, 1.0 - skew);
+    if (i + 3 < n) entries.emplace_back(i, i + 3, 0.3);
+  }
+  Eigen::SparseMatrix<double> a(n, n);
+  a.setFromTriplets(entries.begin(), entries.end());
+  a.makeCompressed();
+  return a;
+}
+
+TEST(SymmetricFactorisation, SolvesWithTheSymmetricPart) {
+  const int n = 40;
+  const Eigen::SparseMatrix<double> a = bandedMatrix(n, 4.0, 0.5);
+  CholmodSolver solver(n);
+  ASSERT_TRUE(solver.factorize(a, false));
+  EXPECT_NE(std::string(solver.name()).find("CHOLMOD"), std::string::npos);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  Eigen::VectorXd x = rhs;
+  solver.solve(x);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
+  const Eigen::MatrixXd symmetricPart = 0.5 * (dense + dense.transpose());
+  EXPECT_LT((symmetricPart * x - rhs).norm(), 1e-12 * rhs.norm());
+  // and not with A: the skew part (0.5 off the diagonal) is not negligible
+  EXPECT_GT((dense * x - rhs).norm(), 1e-2 * rhs.norm());
+
+  // new values on the same pattern are factorised afresh
+  const Eigen::SparseMatrix<double> b = bandedMatrix(n, 6.0, -0.2);
+  ASSERT_TRUE(solver.factorize(b, false));
+  x = rhs;
+  solver.solve(x);
+  const Eigen::MatrixXd denseB = Eigen::MatrixXd(b);
+  EXPECT_LT((0.5 * (denseB + denseB.transpose()) * x - rhs).norm(), 1e-12 * rhs.norm());
+}
+
+TEST(SymmetricFactorisation, FallsBackToTheLuOfTheMatrixWhereTheSymmetricPartIsIndefinite) {
+  const int n = 40;
+  // diagonal 0.5 against off-diagonal sums up to 2.6: the symmetric part is indefinite, while
+  // the matrix itself is regular
+  const Eigen::SparseMatrix<double> a = bandedMatrix(n, 0.5, 0.0);
+  CholmodSolver solver(n);
+  ASSERT_TRUE(solver.factorize(a, false));
+  EXPECT_NE(std::string(solver.name()).find("UMFPACK"), std::string::npos);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::Ones(n);
+  Eigen::VectorXd x = rhs;
+  solver.solve(x);
+  EXPECT_LT((a * x - rhs).norm(), 1e-10 * rhs.norm());
+  // and stays with the LU for later matrices, also positive definite ones
+  const Eigen::SparseMatrix<double> b = bandedMatrix(n, 4.0, 0.5);
+  ASSERT_TRUE(solver.factorize(b, false));
+  x = rhs;
+  solver.solve(x);
+  EXPECT_LT((b * x - rhs).norm(), 1e-12 * rhs.norm());
+}
+
+}  // namespace
+}  // namespace mpx::test
