@@ -58,9 +58,20 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
             map.emplace_back(static_cast<int>(i + j * dofs.size()),
                              findEntry(tangent_, dofs[i] + rowStage * n, dofs[j] + columnStage * n));
           }
+        // by matrix entry (a component reaches each entry once), so that a part is a range
+        std::sort(map.begin(), map.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
         scatterMap_.push_back(std::move(map));
       }
   }
+  scatterParts_ = std::max(1, omp_get_max_threads());
+  const long long entryCount = tangent_.nonZeros();
+  for (const auto& map : scatterMap_)
+    for (int p = 0; p <= scatterParts_; ++p) {
+      const int bound = static_cast<int>(entryCount * p / scatterParts_);
+      const auto start = std::lower_bound(map.begin(), map.end(), bound,
+                                          [](const std::pair<int, int>& pair, int e) { return pair.second < e; });
+      partStart_.push_back(static_cast<int>(start - map.begin()));
+    }
   // rows of the prescribed motions at every stage, to be overwritten
   const auto& prescribed = model.prescribedMotions();
   prescribedRowEntries_.assign(prescribed.size() * stages, {});
@@ -99,19 +110,29 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
 
 void Assembler::clear(bool tangent) {
   residual_.setZero();
-  if (tangent) std::fill_n(tangent_.valuePtr(), tangent_.nonZeros(), 0.0);
+  // the tangent's values part by part, on the threads where there are enough of them
+  double* values = tangent_.valuePtr();
+  const long long entryCount = tangent_.nonZeros();
+  auto clearPart = [&](int p) {
+    std::fill(values + entryCount * p / scatterParts_, values + entryCount * (p + 1) / scatterParts_, 0.0);
+  };
+  if (tangent) forEachPart(static_cast<int>(std::min<long long>(entryCount / kEntriesPerSlot, kBatch)), clearPart);
   flows_ = Flows{};
   if (keepComponentFlows_) std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }
 
-void Assembler::scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local,
-                        const Pass& pass) {
-  assert(static_cast<int>(dofs.size()) == local.n && "a local system of another size than its dof list");
-  if (pass.withResidual) scatterResidual(component, dofs, local.r, pass.block / stages_, pass.weight);
-  if (!pass.withTangent) return;
+void Assembler::scatterTangents(const std::size_t* batch, int count, const Pass& pass) {
   double* values = tangent_.valuePtr();
-  for (const auto& [localEntry, value] : scatterMap_[component * stages_ * stages_ + pass.block])
-    values[value] += pass.weight * local.k[localEntry];
+  // part p of every slot's map, slot by slot: each entry's terms arrive in component order
+  auto scatterPart = [&](int p) {
+    for (int b = 0; b < count; ++b) {
+      const std::size_t m = batch[b] * stages_ * stages_ + pass.block;
+      const auto& map = scatterMap_[m];
+      const int* start = partStart_.data() + m * (scatterParts_ + 1);
+      for (int e = start[p]; e < start[p + 1]; ++e) values[map[e].second] += pass.weight * locals_[b].k[map[e].first];
+    }
+  };
+  forEachPart(count, scatterPart);
 }
 
 void Assembler::scatterResidual(std::size_t component, const std::vector<int>& dofs, const double* r, int stage,

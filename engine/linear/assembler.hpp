@@ -4,8 +4,10 @@
 // assembly allocates nothing and never rebuilds the pattern.
 //
 // Components are evaluated in batches, in parallel with OpenMP (OMP_NUM_THREADS threads) when
-// a batch is large enough to pay for it; the batch is then scattered in component order by one
-// thread, so the sums, and the results, are the same bit for bit for any number of threads.
+// a batch is large enough to pay for it. The batch's tangents are then scattered in parallel
+// too, each thread into its own range of the matrix entries, going through the components in
+// order: every entry receives its terms in component order, so the sums, and the results, are
+// the same bit for bit for any number of threads.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
 
@@ -103,9 +105,10 @@ class Assembler {
         evaluate(*components[batch[b]], ws, local, localFlows_[b]);
       };
       forEachSlot(count, evaluateSlot);
+      if (pass.withTangent) scatterTangents(batch, count, pass);
+      if (!pass.withResidual) continue;
       for (int b = 0; b < count; ++b) {
-        scatter(batch[b], components[batch[b]]->dofs(), locals_[b], pass);
-        if (!pass.withResidual) continue;
+        scatterResidual(batch[b], components[batch[b]]->dofs(), locals_[b].r, pass.block / stages_, pass.weight);
         flows_ += localFlows_[b] * pass.flowWeight;
         if (keepComponentFlows_) componentFlows_[batch[b]] += localFlows_[b] * pass.flowWeight;
       }
@@ -122,6 +125,17 @@ class Assembler {
       for (int b = 0; b < count; ++b) evaluateSlot(b);
     } else {
       for (int b = 0; b < count; ++b) evaluateSlot(b);
+    }
+  }
+  // scatterPart(p) for every part p of the matrix entries, in parallel for a batch of `count` slots
+  // where evaluating them would be
+  template <class ScatterPart>
+  void forEachPart(int count, const ScatterPart& scatterPart) const {
+    if (count >= kSmallestParallelBatch && scatterParts_ > 1 && omp_get_max_threads() > 1) {
+#pragma omp parallel for schedule(static)
+      for (int p = 0; p < scatterParts_; ++p) scatterPart(p);
+    } else {
+      for (int p = 0; p < scatterParts_; ++p) scatterPart(p);
     }
   }
   // The residuals of all stages of the components that evaluate their stages together.
@@ -161,7 +175,9 @@ class Assembler {
   // At stage `stage` of a multi-stage system, with the reaction's flows times `weight`.
   void replaceRow(std::size_t k, const PrescribedMotion& p, double value, double diagonal, double conjugate,
                   int stage = 0, double weight = 1.0);
-  void scatter(std::size_t component, const std::vector<int>& dofs, const LocalSystem& local, const Pass& pass);
+  // Add the tangents of a batch's slots (pass.weight times) to tangent block pass.block: one
+  // part of the matrix entries per thread when the batch is large enough.
+  void scatterTangents(const std::size_t* batch, int count, const Pass& pass);
   // Add weight r (the component's local residual) to the rows of `dofs` at stage `stage`.
   void scatterResidual(std::size_t component, const std::vector<int>& dofs, const double* r, int stage, double weight);
 
@@ -175,8 +191,12 @@ class Assembler {
   int stages_ = 1;
   int size_ = 0;  // of the model's state: the offset from one stage's unknowns to the next
   // per component and tangent block (component stages^2 + rowStage stages + columnStage):
-  // (local column-major entry, position in tangent_ values) of its coupled pairs
+  // (local column-major entry, position in tangent_ values) of its coupled pairs, by position
   std::vector<std::vector<std::pair<int, int>>> scatterMap_;
+  // the matrix entries split into scatterParts_ ranges of about equal size: map m's pairs in
+  // part p are [partStart_[m (parts + 1) + p], partStart_[m (parts + 1) + p + 1])
+  int scatterParts_ = 1;
+  std::vector<int> partStart_;
   // per prescribed motion and stage (k stages + l): its row, and its diagonal, in tangent_ values
   std::vector<std::vector<int>> prescribedRowEntries_;
   std::vector<int> prescribedDiagonal_;
@@ -192,6 +212,9 @@ class Assembler {
   // threads costs more than they save: docs/performance.md, "Parallel assembly").
   static constexpr std::size_t kBatch = 256;
   static constexpr int kSmallestParallelBatch = 32;
+  // Clearing the tangent counts as a batch of one slot per this many entries (a matrix of
+  // kSmallestParallelBatch times as many entries is cleared in parallel).
+  static constexpr long long kEntriesPerSlot = 4096;
   PassOrder everyComponent_;
   // the components that evaluate their stages together (Component::evaluatesStagesTogether),
   // and the others, which a residual-only stage pass evaluates one stage at a time
