@@ -24,48 +24,47 @@ Eigen::SparseMatrix<double> bandedMatrix(int n, double diagonal, double skew) {
   return a;
 }
 
-TEST(SymmetricFactorisation, SolvesWithTheSymmetricPart) {
-  const int n = 40;
-  const Eigen::SparseMatrix<double> a = bandedMatrix(n, 4.0, 0.5);
-  CholmodSolver solver(n);
-  ASSERT_TRUE(solver.factorize(a, false));
-  EXPECT_NE(std::string(solver.name()).find("CHOLMOD"), std::string::npos);
-  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+// Factorise `a` (expected to succeed) and solve with rhs.
+Eigen::VectorXd factorizeAndSolve(CholmodSolver& solver, const Eigen::SparseMatrix<double>& a,
+                                  const Eigen::VectorXd& rhs) {
+  EXPECT_TRUE(solver.factorize(a, false));
   Eigen::VectorXd x = rhs;
   solver.solve(x);
-  const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
-  const Eigen::MatrixXd symmetricPart = 0.5 * (dense + dense.transpose());
-  EXPECT_LT((symmetricPart * x - rhs).norm(), 1e-12 * rhs.norm());
-  // and not with A: the skew part (0.5 off the diagonal) is not negligible
-  EXPECT_GT((dense * x - rhs).norm(), 1e-2 * rhs.norm());
+  return x;
+}
 
+Eigen::MatrixXd symmetricPartOf(const Eigen::SparseMatrix<double>& a) {
+  const Eigen::MatrixXd dense(a);
+  return 0.5 * (dense + dense.transpose());
+}
+
+TEST(SymmetricFactorisation, SolvesWithTheSymmetricPart) {
+  const int n = 40;
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  CholmodSolver solver(n);
+  const Eigen::SparseMatrix<double> a = bandedMatrix(n, 4.0, 0.5);
+  const Eigen::VectorXd x = factorizeAndSolve(solver, a, rhs);
+  EXPECT_NE(std::string(solver.name()).find("CHOLMOD"), std::string::npos);
+  EXPECT_LT((symmetricPartOf(a) * x - rhs).norm(), 1e-12 * rhs.norm());
+  // and not with A: the skew part (0.5 off the diagonal) is not negligible
+  EXPECT_GT((a * x - rhs).norm(), 1e-2 * rhs.norm());
   // new values on the same pattern are factorised afresh
   const Eigen::SparseMatrix<double> b = bandedMatrix(n, 6.0, -0.2);
-  ASSERT_TRUE(solver.factorize(b, false));
-  x = rhs;
-  solver.solve(x);
-  const Eigen::MatrixXd denseB = Eigen::MatrixXd(b);
-  EXPECT_LT((0.5 * (denseB + denseB.transpose()) * x - rhs).norm(), 1e-12 * rhs.norm());
+  EXPECT_LT((symmetricPartOf(b) * factorizeAndSolve(solver, b, rhs) - rhs).norm(), 1e-12 * rhs.norm());
 }
 
 TEST(SymmetricFactorisation, FallsBackToTheLuOfTheMatrixWhereTheSymmetricPartIsIndefinite) {
   const int n = 40;
+  const Eigen::VectorXd rhs = Eigen::VectorXd::Ones(n);
+  CholmodSolver solver(n);
   // diagonal 0.5 against off-diagonal sums up to 2.6: the symmetric part is indefinite, while
   // the matrix itself is regular
   const Eigen::SparseMatrix<double> a = bandedMatrix(n, 0.5, 0.0);
-  CholmodSolver solver(n);
-  ASSERT_TRUE(solver.factorize(a, false));
+  EXPECT_LT((a * factorizeAndSolve(solver, a, rhs) - rhs).norm(), 1e-10 * rhs.norm());
   EXPECT_NE(std::string(solver.name()).find("UMFPACK"), std::string::npos);
-  const Eigen::VectorXd rhs = Eigen::VectorXd::Ones(n);
-  Eigen::VectorXd x = rhs;
-  solver.solve(x);
-  EXPECT_LT((a * x - rhs).norm(), 1e-10 * rhs.norm());
   // and stays with the LU for later matrices, also positive definite ones
   const Eigen::SparseMatrix<double> b = bandedMatrix(n, 4.0, 0.5);
-  ASSERT_TRUE(solver.factorize(b, false));
-  x = rhs;
-  solver.solve(x);
-  EXPECT_LT((b * x - rhs).norm(), 1e-12 * rhs.norm());
+  EXPECT_LT((b * factorizeAndSolve(solver, b, rhs) - rhs).norm(), 1e-12 * rhs.norm());
 }
 
 }  // namespace
