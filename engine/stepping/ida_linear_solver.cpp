@@ -1,20 +1,19 @@
 #include "engine/stepping/ida_linear_solver.hpp"
 
-#include "engine/linear/sparse_lu.hpp"
+#include "engine/linear/condensed_solver.hpp"
 
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
-#include <memory>
 
 namespace mpx {
 
 namespace {
 
 struct Content {
-  std::unique_ptr<SparseLu> lu;
+  CondensedSolver solver;
   Eigen::SparseMatrix<double> matrix;  // the pattern, with the values of the last setup
-  Eigen::VectorXd rhs;
+  Eigen::VectorXd rhs, increment;
 };
 
 Content& content(SUNLinearSolver solver) { return *static_cast<Content*>(solver->content); }
@@ -27,15 +26,17 @@ int initialize(SUNLinearSolver) { return SUNLS_SUCCESS; }
 int setup(SUNLinearSolver solver, SUNMatrix a) {
   Content& c = content(solver);
   std::copy_n(SUNSparseMatrix_Data(a), c.matrix.nonZeros(), c.matrix.valuePtr());
-  return c.lu->factorize(c.matrix, false) ? SUNLS_SUCCESS : SUNLS_LUFACT_FAIL;
+  return c.solver.factorize(c.matrix, false) ? SUNLS_SUCCESS : SUNLS_LUFACT_FAIL;
 }
 
 int solve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   Content& c = content(solver);
   const double* in = N_VGetArrayPointer(b);
   std::copy(in, in + c.rhs.size(), c.rhs.data());
-  c.lu->solve(c.rhs);
-  std::copy(c.rhs.data(), c.rhs.data() + c.rhs.size(), N_VGetArrayPointer(x));
+  // the condensed solver gives the Newton increment -A^{-1} b
+  c.solver.solve(c.rhs, c.increment);
+  double* out = N_VGetArrayPointer(x);
+  for (Eigen::Index i = 0; i < c.increment.size(); ++i) out[i] = -c.increment[i];
   return SUNLS_SUCCESS;
 }
 
@@ -48,9 +49,11 @@ int release(SUNLinearSolver solver) {
 
 }  // namespace
 
-SUNLinearSolver makeIdaLinearSolver(const Eigen::SparseMatrix<double>& pattern, SUNContext context) {
+SUNLinearSolver makeIdaLinearSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern,
+                                    SUNContext context) {
   SUNLinearSolver solver = SUNLinSolNewEmpty(context);
-  auto* c = new Content{makeSparseLu(static_cast<int>(pattern.rows())), pattern, Eigen::VectorXd(pattern.rows())};
+  auto* c = new Content{CondensedSolver(layout, pattern), pattern, Eigen::VectorXd(pattern.rows()),
+                        Eigen::VectorXd(pattern.rows())};
   solver->content = c;
   solver->ops->gettype = type;
   solver->ops->getid = id;
@@ -61,6 +64,6 @@ SUNLinearSolver makeIdaLinearSolver(const Eigen::SparseMatrix<double>& pattern, 
   return solver;
 }
 
-const char* idaLinearSolverName(SUNLinearSolver solver) { return content(solver).lu->name(); }
+std::string idaLinearSolverDescription(SUNLinearSolver solver) { return content(solver).solver.describe(); }
 
 }  // namespace mpx

@@ -1,20 +1,27 @@
 #pragma once
-// A SUNDIALS linear solver over Metriplex's own sparse LU (KLU or UMFPACK, see
-// engine/linear/sparse_lu.hpp), so that IDA factorises its Newton matrix with the same solver
-// as the one-step integrators: UMFPACK with METIS for 3D solids, where SUNDIALS' KLU is 20-60
-// times slower (docs/performance.md).
+// A SUNDIALS linear solver over Metriplex's own condensed sparse solver (engine/linear/
+// condensed_solver.hpp: velocities eliminated through the kinematic rows, then KLU or UMFPACK),
+// so that IDA factorises its Newton matrix as the one-step integrators do: half the unknowns for
+// mechanics, and UMFPACK with METIS for 3D solids, where SUNDIALS' KLU is 20-60 times slower
+// (docs/performance.md).
+#include "engine/core/layout.hpp"
+
 #include <Eigen/Sparse>
 
 #include <sundials/sundials_context.h>
 #include <sundials/sundials_linearsolver.h>
 
+#include <string>
+
 namespace mpx {
 
 // The solver factorises compressed-column SUNSparseMatrix values whose pattern is `pattern`'s
-// (IDA's Jacobian callback copies that matrix in); solves allocate nothing. Free it with
-// SUNLinSolFree.
-SUNLinearSolver makeIdaLinearSolver(const Eigen::SparseMatrix<double>& pattern, SUNContext context);
-// The name of the factorisation a solver from makeIdaLinearSolver uses ("UMFPACK", ...).
-const char* idaLinearSolverName(SUNLinearSolver solver);
+// (IDA's Jacobian callback copies that matrix in), over the state layout `layout`; solves
+// allocate nothing. Free it with SUNLinSolFree.
+SUNLinearSolver makeIdaLinearSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern,
+                                    SUNContext context);
+// What a solver from makeIdaLinearSolver factorises ("270 of 540 unknowns factorised by KLU
+// (velocities eliminated)", ...).
+std::string idaLinearSolverDescription(SUNLinearSolver solver);
 
 }  // namespace mpx

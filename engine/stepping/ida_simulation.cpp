@@ -130,12 +130,11 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   } else if (options.sundialsKlu) {
     linearSolver_ = SUNLinSol_KLU(y_, jacobian_, context_);
   } else {
-    linearSolver_ = makeIdaLinearSolver(assembler_.tangent(), context_);
+    linearSolver_ = makeIdaLinearSolver(model.layout(), assembler_.tangent(), context_);
   }
-  linearSystem_ = std::to_string(n) + " unknowns factorised by " +
-                  (dense_                ? "dense LU (SUNDIALS)"
-                   : options.sundialsKlu ? "KLU (SUNDIALS)"
-                                         : idaLinearSolverName(linearSolver_));
+  linearSystem_ = dense_ || options.sundialsKlu ? std::to_string(n) + " unknowns factorised by " +
+                                                      (dense_ ? "dense LU (SUNDIALS)" : "KLU (SUNDIALS)")
+                                                : idaLinearSolverDescription(linearSolver_);
   check(IDASetLinearSolver(ida_, linearSolver_, jacobian_), "IDASetLinearSolver");
   check(IDASetJacFn(ida_, jacobian), "IDASetJacFn");
 }
