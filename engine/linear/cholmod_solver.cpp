@@ -80,7 +80,8 @@ bool CholmodSolver::factorize(const Eigen::SparseMatrix<double>& matrix, bool re
     notPositiveDefinite_ = true;
     return lu_.factorize(matrix, repivot);
   }
-  return common_.status == CHOLMOD_OK;
+  // a warning (a tiny diagonal entry) leaves a usable factor; negative codes are failures
+  return common_.status >= CHOLMOD_OK;
 }
 
 void CholmodSolver::solve(Eigen::VectorXd& rhs) {
