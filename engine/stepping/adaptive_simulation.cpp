@@ -168,7 +168,6 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   NewtonSettings newton = options.newton;
   newton.maxCutbacks = 0;
   Integrator integrator(model, options.scheme, newton);
-  summary.linearSystem = integrator.linearSolver().describe();
   const Checkpointing& checkpoints = options.checkpoints;
   RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
   LocalError localError(model, control, schemeOrder(options.scheme));
@@ -276,6 +275,8 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
     }
     if (!goOn) break;
   }
+  // what factorised the steps in the end (a symmetric factorisation may have handed over to the LU)
+  summary.linearSystem = integrator.linearSolver().describe();
   reporter.finish();
   return summary;
 }

@@ -178,7 +178,6 @@ void ComponentFlows::accept(int k) {
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink, const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
-  summary.linearSystem = integrator.linearSolver().describe();
   // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
   const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
   const Checkpointing& checkpoints = options.checkpoints;
@@ -216,6 +215,8 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     }
     if (!goOn) break;
   }
+  // what factorised the steps in the end (a symmetric factorisation may have handed over to the LU)
+  summary.linearSystem = integrator.linearSolver().describe();
   reporter.finish();
   return summary;
 }
