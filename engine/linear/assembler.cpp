@@ -64,11 +64,9 @@ Assembler::Assembler(const Model& model, Component::LocalForm form, int stages)
       }
   }
   scatterParts_ = std::max(1, omp_get_max_threads());
-  const long long entryCount = tangent_.nonZeros();
   for (const auto& map : scatterMap_)
     for (int p = 0; p <= scatterParts_; ++p) {
-      const int bound = static_cast<int>(entryCount * p / scatterParts_);
-      const auto start = std::lower_bound(map.begin(), map.end(), bound,
+      const auto start = std::lower_bound(map.begin(), map.end(), partBound(p),
                                           [](const std::pair<int, int>& pair, int e) { return pair.second < e; });
       partStart_.push_back(static_cast<int>(start - map.begin()));
     }
@@ -112,11 +110,9 @@ void Assembler::clear(bool tangent) {
   residual_.setZero();
   // the tangent's values part by part, on the threads where there are enough of them
   double* values = tangent_.valuePtr();
-  const long long entryCount = tangent_.nonZeros();
-  auto clearPart = [&](int p) {
-    std::fill(values + entryCount * p / scatterParts_, values + entryCount * (p + 1) / scatterParts_, 0.0);
-  };
-  if (tangent) forEachPart(static_cast<int>(std::min<long long>(entryCount / kEntriesPerSlot, kBatch)), clearPart);
+  auto clearPart = [&](int p) { std::fill(values + partBound(p), values + partBound(p + 1), 0.0); };
+  if (tangent)
+    forEachPart(static_cast<int>(std::min<long long>(tangent_.nonZeros() / kEntriesPerSlot, kBatch)), clearPart);
   flows_ = Flows{};
   if (keepComponentFlows_) std::fill(componentFlows_.begin(), componentFlows_.end(), Flows{});
 }

@@ -197,6 +197,10 @@ class Assembler {
   // part p are [partStart_[m (parts + 1) + p], partStart_[m (parts + 1) + p + 1])
   int scatterParts_ = 1;
   std::vector<int> partStart_;
+  // the first matrix entry of part p (the number of entries for p = scatterParts_)
+  int partBound(int p) const {
+    return static_cast<int>(static_cast<long long>(tangent_.nonZeros()) * p / scatterParts_);
+  }
   // per prescribed motion and stage (k stages + l): its row, and its diagonal, in tangent_ values
   std::vector<std::vector<int>> prescribedRowEntries_;
   std::vector<int> prescribedDiagonal_;
