@@ -2,6 +2,7 @@
 // (A + A^T)/2 where that is positive definite, and with A itself (UMFPACK) from the first
 // matrix whose symmetric part is not.
 #include "engine/linear/cholmod_solver.hpp"
+#include "engine/linear/condensed_solver.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -65,6 +66,22 @@ TEST(SymmetricFactorisation, FallsBackToTheLuOfTheMatrixWhereTheSymmetricPartIsI
   // and stays with the LU for later matrices, also positive definite ones
   const Eigen::SparseMatrix<double> b = bandedMatrix(n, 4.0, 0.5);
   EXPECT_LT((b * factorizeAndSolve(solver, b, rhs) - rhs).norm(), 1e-12 * rhs.norm());
+}
+
+// The condensed solver describes what factorised its last system, which run summaries read when
+// the run ends: a large system whose symmetric part is indefinite is reported as the LU that took
+// over, and solved with it.
+TEST(SymmetricFactorisation, CondensedSolverReportsTheLuThatTookOver) {
+  const int n = kLargeSystem;
+  const Eigen::SparseMatrix<double> a = bandedMatrix(n, 0.5, 0.0);
+  CondensedSolver solver(Layout({0, 0, n, 0, 0}), a, true);
+  EXPECT_NE(solver.describe().find("CHOLMOD"), std::string::npos) << solver.describe();
+  ASSERT_TRUE(solver.factorize(a, false));
+  EXPECT_NE(solver.describe().find("UMFPACK"), std::string::npos) << solver.describe();
+  const Eigen::VectorXd residual = Eigen::VectorXd::Ones(n);
+  Eigen::VectorXd increment(n);
+  solver.solve(residual, increment);
+  EXPECT_LT((a * increment + residual).norm(), 1e-10 * residual.norm());
 }
 
 }  // namespace
