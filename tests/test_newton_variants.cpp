@@ -175,6 +175,34 @@ TEST(NewtonPredictor, SavesIterationsOnASmoothTrajectory) {
       << with.summary.newtonIterations << " against " << without.summary.newtonIterations;
 }
 
+// eem4's predictor continues the last step's stage polynomial: its extrapolation weights on
+// {c_1, c_2, 1} reproduce every quadratic beyond the step's end.
+TEST(NewtonPredictor, Eem4ExtrapolationReproducesQuadratics) {
+  const CollocationRule rule = gaussCollocation(2);
+  auto quadratic = [](double tau) { return 0.3 - 1.7 * tau + 2.9 * tau * tau; };
+  for (const double x : {0.2, 0.8, 1.6}) {
+    const auto weight = extrapolationWeights(rule, x);
+    const double extrapolated =
+        weight[0] * quadratic(rule.node[0]) + weight[1] * quadratic(rule.node[1]) + weight[2] * quadratic(1.0);
+    EXPECT_NEAR(extrapolated, quadratic(1.0 + x), 1e-12) << "x = " << x;
+  }
+}
+
+// On the smooth thermo-springs the stage polynomial is a better start than the line through the
+// last two states: 311 iterations over t in [0, 20] at dt 0.2 (3.11 per step), where the stages
+// on that line took 337 (and the old state alone more).
+TEST(NewtonPredictor, Eem4StagePolynomialSavesIterations) {
+  const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));
+  NewtonSettings off = scene.settings.newton, on = off;
+  off.predictor = false;
+  on.predictor = true;
+  const History without = run(*scene.model, Scheme::Eem4, 0.2, 20.0, off);
+  const History with = run(*scene.model, Scheme::Eem4, 0.2, 20.0, on);
+  ASSERT_FALSE(with.summary.failed) << with.summary.failure;
+  EXPECT_LT(with.summary.newtonIterations, 325) << "without the predictor: " << without.summary.newtonIterations;
+  EXPECT_LT(with.summary.newtonIterations, without.summary.newtonIterations);
+}
+
 // On a system large enough for the sparse Cholesky path (the L-block at mesh level 3: 4116
 // condensed unknowns), simplified Newton with the symmetric part factorised by CHOLMOD solves
 // with an approximate matrix, so it needs more iterations, but it judges its iterates on the

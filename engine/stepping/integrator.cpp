@@ -1,5 +1,6 @@
 #include "engine/stepping/integrator.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -43,6 +44,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
     stages_.resize(rule_.stages * n);
     stageRates_.resize(rule_.stages * n);
     stageEnd_.resize(n);
+    lastStages_.resize(rule_.stages * n);
   }
 }
 
@@ -100,11 +102,12 @@ void Integrator::addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& s
 }
 
 bool Integrator::solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
-                           StepOutcome& outcome) {
+                           StepOutcome& outcome, bool stagesGuessed) {
   if (rule_.stages == 1) return solveUnknowns(zOld, t, dt, zNew, outcome);
-  // the stages start on the line from the old state to the guessed end state
+  // the stages start on the line from the old state to the guessed end state, unless guessed
   const int n = static_cast<int>(zOld.size());
-  for (int l = 0; l < rule_.stages; ++l) stages_.segment(l * n, n) = zOld + rule_.node[l] * (zNew - zOld);
+  if (!stagesGuessed)
+    for (int l = 0; l < rule_.stages; ++l) stages_.segment(l * n, n) = zOld + rule_.node[l] * (zNew - zOld);
   if (!solveUnknowns(zOld, t, dt, stages_, outcome)) return false;
   endOfStages(zOld, stages_, zNew);
   return true;
@@ -199,6 +202,18 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   }
 }
 
+void Integrator::extrapolateStages(double dt) {
+  const int n = static_cast<int>(lastEnd_.size()), s = rule_.stages;
+  for (int l = 0; l < s; ++l) {
+    // from the increments over the last end state (the weights sum to one)
+    const std::array<double, CollocationRule::kMostStages + 1> weight =
+        extrapolationWeights(rule_, rule_.node[l] * dt / lastDt_);
+    auto stage = stages_.segment(l * n, n);
+    stage = lastEnd_;
+    for (int j = 0; j < s; ++j) stage += weight[j] * (lastStages_.segment(j * n, n) - lastEnd_);
+  }
+}
+
 bool Integrator::refactorize(double dt, bool repivot, StepOutcome& outcome) {
   factorizedDt_ = 0.0;
   ++outcome.factorizations;
@@ -227,8 +242,12 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
   const bool continues = level == 0 && settings_.predictor &&
                          std::abs(t - (lastTime_ + lastDt_)) <= 1e-12 * (std::abs(t) + lastDt_) && z == lastEnd_;
   if (continues) {
-    zNew = z + (dt / lastDt_) * (lastEnd_ - lastStart_);
-    if (solveStep(z, t, dt, zNew, outcome)) return true;
+    const bool stagesGuessed = lastStagesKept_;
+    if (stagesGuessed)
+      extrapolateStages(dt);
+    else
+      zNew = z + (dt / lastDt_) * (lastEnd_ - lastStart_);
+    if (solveStep(z, t, dt, zNew, outcome, stagesGuessed)) return true;
     factorizedDt_ = 0.0;
   }
   zNew = z;
@@ -250,6 +269,9 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
   if (byComponent) std::fill(byComponent->begin(), byComponent->end(), Flows{});
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
   if (outcome.converged) {
+    // eem4: the stages of a step taken whole give the next step's guess
+    lastStagesKept_ = rule_.stages > 1 && outcome.cutbacks == 0;
+    if (lastStagesKept_) lastStages_ = stages_;
     lastStart_ = z;
     lastEnd_ = zNew;
     lastTime_ = t;
@@ -265,6 +287,9 @@ void Integrator::checkpoint(LoopState& out) {
   out.predictorDt = lastDt_;
   solver_.startAfresh();
   factorizedDt_ = 0.0;
+  // the stage predictor is not saved: the step after a checkpoint extrapolates linearly, in
+  // the run that wrote it as in a restart from it
+  lastStagesKept_ = false;
 }
 
 void Integrator::resume(const LoopState& saved) {
@@ -272,6 +297,7 @@ void Integrator::resume(const LoopState& saved) {
   lastEnd_ = saved.predictorEnd;
   lastTime_ = saved.predictorTime;
   lastDt_ = saved.predictorDt;
+  lastStagesKept_ = false;
 }
 
 }  // namespace mpx

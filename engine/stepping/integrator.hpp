@@ -44,8 +44,9 @@ struct NewtonSettings {
   // but the last iterate is less converged than after a fresh Newton step, and the stiff
   // thermal chain's energy balance ends at 1.6e-12 instead of 3e-14 (docs/performance.md).
   double reuseBelowIncrement = 0.0;
-  // Start each step from the linear extrapolation of the previous two states (when the step
-  // continues the last one) instead of from the old state.
+  // Start each step that continues the last one from the linear extrapolation of the previous
+  // two states (eem4: its stages from the last step's stage polynomial, if that step was taken
+  // whole) instead of from the old state.
   bool predictor = true;
 };
 
@@ -91,8 +92,12 @@ class Integrator {
   void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt, bool tangent);
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
-  // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess).
-  bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome);
+  // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess,
+  // or, if stagesGuessed, from the stage values already in stages_).
+  bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome,
+                 bool stagesGuessed = false);
+  // eem4: the last step's stage polynomial at this step's stages, into stages_.
+  void extrapolateStages(double dt);
   bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
   // eem4: the stage rates and the end state of the stage polynomial, then its residual.
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
@@ -123,6 +128,9 @@ class Integrator {
   // predictor: the last accepted step, lastStart_ at lastTime_ to lastEnd_ over lastDt_
   Eigen::VectorXd lastStart_, lastEnd_;
   double lastTime_ = NAN, lastDt_ = 0.0;
+  // eem4: the last step's stages, if it was taken whole, and which guess to start from
+  Eigen::VectorXd lastStages_;
+  bool lastStagesKept_ = false;
   std::vector<Flows>* byComponent_ = nullptr;  // of the advance under way, if asked for
 };
 
