@@ -14,6 +14,8 @@ namespace mpx {
 using cell::branchStressOf;
 using cell::contract;
 using cell::kComponent;
+using cell::strainChangeOfRow;
+using cell::SymmetricTangent;
 
 namespace {
 std::vector<int> collectDofs(const SolidElementSpec& spec) {
@@ -184,12 +186,13 @@ void SolidElement::assemblePoint(int q, const PointEvaluation& e, const Material
   };
 
   // columns of the end positions: dF = e_j dN_b/dX^T changes C by dF^T F + F^T dF
+  const SymmetricTangent tangent(materialIncrement);
   for (int b = 0; b < nodes_; ++b)
     for (int j = 0; j < 3; ++j) {
       Mat3 dF = Mat3::Zero();
       dF.row(j) = G.row(b);
-      const Mat3 dC = dF.transpose() * e.endGradient + e.endGradient.transpose() * dF;
-      Mat3 dStress = materialIncrement(dC);
+      const Mat3 dC = strainChangeOfRow(e.endGradient, j, G.row(b));
+      Mat3 dStress = tangent(dC);
       if (spec_.branch) {
         const Mat3 dBranch = branchStressOf(*spec_.branch, e.strainFactor * dC);
         dStress += dBranch;

@@ -26,6 +26,8 @@ namespace mpx {
 using cell::branchStressOf;
 using cell::contract;
 using cell::kComponent;
+using cell::strainChangeOfRow;
+using cell::SymmetricTangent;
 
 namespace {
 constexpr int kStages = CollocationRule::kMostStages;
@@ -72,9 +74,9 @@ PointPath pointPath(const CellPositions (&basis)[kStages + 1], const CellPositio
   return path;
 }
 
-// What a change dF of F at stage `column` (one position column) does to the path: each stage's
-// C', C at that stage and at the end (with its end coefficient), and the norm. All zero for a
-// column that leaves the positions.
+// What a change dF = e_row g^T of F at stage `column` (one position column: a node's shape
+// gradient g in one row) does to the path: each stage's C', C at that stage and at the end
+// (with its end coefficient), and the norm. All zero for a column that leaves the positions.
 struct PathChange {
   PathChange() {
     for (Mat3& rate : strainRate) rate.setZero();
@@ -84,13 +86,14 @@ struct PathChange {
   double norm = 0.0;
 };
 
-PathChange pathChange(const PointPath& path, const CollocationRule& rule, int column, const Mat3& dF) {
+PathChange pathChange(const PointPath& path, const CollocationRule& rule, int column, int row,
+                      const Eigen::RowVector3d& g) {
   PathChange change;
-  change.ownStrain = strainChange(path.F[column], dF);
-  change.endStrain = rule.end[column + 1] * strainChange(path.FEnd, dF);
+  change.ownStrain = strainChangeOfRow(path.F[column], row, g);
+  change.endStrain = rule.end[column + 1] * strainChangeOfRow(path.FEnd, row, g);
   for (int j = 0; j < rule.stages; ++j) {
-    change.strainRate[j] = strainChange(path.F[j], rule.rate[j][column + 1] * dF);
-    if (j == column) change.strainRate[j] += strainChange(path.rate[j], dF);
+    change.strainRate[j] = rule.rate[j][column + 1] * strainChangeOfRow(path.F[j], row, g);
+    if (j == column) change.strainRate[j] += strainChangeOfRow(path.rate[j], row, g);
     change.norm += 2.0 * rule.weight[j] * contract(path.strainRate[j], change.strainRate[j]);
   }
   return change;
@@ -102,7 +105,7 @@ PathChange pathChange(const PointPath& path, const CollocationRule& rule, int co
 class StrainEnergyPath {
  public:
   StrainEnergyPath(const HyperelasticMaterial& law, const PointPath& path, const CollocationRule& rule, int column)
-      : law_(law), path_(path), rule_(rule), column_(column) {
+      : path_(path), rule_(rule), column_(column) {
     double defect = law.energyDifference(path.C0, path.CEnd);
     for (int j = 0; j < rule.stages; ++j) {
       stress_[j] = law.stress(path.C[j]);
@@ -113,7 +116,8 @@ class StrainEnergyPath {
       gradient_[j] = stress_[j] + 2.0 * correction_.coefficient * path.strainRate[j];
     if (column < 0) return;
     stressEnd_ = law.stress(path.CEnd);
-    columnTangent_ = law.stressIncrement(path.C[column], path.strainRate[column]);
+    tangent_.emplace([&](const Mat3& dC) { return law.stressIncrement(path.C[column], dC); });
+    columnTangent_ = (*tangent_)(path.strainRate[column]);
   }
   const Mat3& gradient(int stage) const { return gradient_[stage]; }
 
@@ -129,16 +133,16 @@ class StrainEnergyPath {
     }
     const double dMu = (dDefect - correction_.coefficient * correction_.normSlope * d.norm) / correction_.norm;
     Mat3 dGradient = 2.0 * dMu * path_.strainRate[stage] + 2.0 * correction_.coefficient * d.strainRate[stage];
-    if (stage == column_) dGradient += law_.stressIncrement(path_.C[stage], d.ownStrain);
+    if (stage == column_) dGradient += (*tangent_)(d.ownStrain);
     return dGradient;
   }
 
  private:
-  const HyperelasticMaterial& law_;
   const PointPath& path_;
   const CollocationRule& rule_;
   int column_;
   Mat3 stress_[kStages], gradient_[kStages], stressEnd_, columnTangent_;
+  std::optional<SymmetricTangent> tangent_;  // dS at the column stage's C
   Correction correction_{};
 };
 
@@ -257,9 +261,11 @@ void SolidElement::addStagePoint(const StageArgs& args, int l, const StagePoint&
       r[firstThermal_ + a] += node[a].temperature.value * w * p.values[a] * entropyRate - p.values[a] * heating;
   if (!args.tangent) return;
 
-  // A position or viscous-strain column of stage `column`: the positions move F by dF (the
-  // path by d), the viscous strain by dGamma.
-  auto addColumn = [&](int localColumn, const Mat3& dF, const PathChange& d, const Mat3& dGamma, bool moves) {
+  // A position or viscous-strain column of stage `column`: the positions move row `row` of F
+  // by g (the path by d; row -1: they stay), the viscous strain by dGamma.
+  auto addColumn = [&](int localColumn, int row, const Eigen::RowVector3d& g, const PathChange& d,
+                       const Mat3& dGamma) {
+    const bool moves = row >= 0;
     Mat3 dStress = moves ? elastic.change(d, l) : Mat3::Zero();
     Mat3 dBranch = Mat3::Zero();
     if (branch) {
@@ -279,20 +285,16 @@ void SolidElement::addStagePoint(const StageArgs& args, int l, const StagePoint&
             node[a].temperature.value * w * p.values[a] * dEntropyRate - p.values[a] * dHeating;
     }
     Mat3 dPiola = w * path.F[l] * dStress;
-    if (l == column) dPiola += w * dF * totalStress;
+    if (l == column && moves) dPiola.row(row) += w * g * totalStress;
     for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, localColumn) += dPiola * G.row(a).transpose();
   };
   for (int b = 0; b < nodes_; ++b)
-    for (int i = 0; i < 3; ++i) {
-      Mat3 dF = Mat3::Zero();
-      dF.row(i) = G.row(b);
-      addColumn(3 * b + i, dF, pathChange(path, rule, column, dF), Mat3::Zero(), true);
-    }
+    for (int i = 0; i < 3; ++i) addColumn(3 * b + i, i, G.row(b), pathChange(path, rule, column, i, G.row(b)), Mat3::Zero());
   if (branch)
     for (int m = 0; m < 6; ++m) {
       Mat3 dGamma = Mat3::Zero();
       dGamma(kComponent[m][0], kComponent[m][1]) = dGamma(kComponent[m][1], kComponent[m][0]) = 1.0;
-      addColumn(gammaRow + m, Mat3::Zero(), PathChange{}, dGamma, false);
+      addColumn(gammaRow + m, -1, Eigen::RowVector3d::Zero(), PathChange{}, dGamma);
       // the viscous strain's own rate
       K(gammaRow + m, gammaRow + m) += rule.rate[l][column + 1] / args.dt;
     }
