@@ -1,8 +1,10 @@
-// The symmetric-part factorisation of engine/linear/cholmod_solver: it solves with
-// (A + A^T)/2 where that is positive definite, and with A itself (UMFPACK) from the first
-// matrix whose symmetric part is not.
+// The factorisations of engine/linear beyond KLU: the symmetric-part factorisation of
+// cholmod_solver solves with (A + A^T)/2 where that is positive definite, and with A itself
+// (UMFPACK) from the first matrix whose symmetric part is not; the dense LU of the smallest
+// systems solves with A and reports a singular one.
 #include "engine/linear/cholmod_solver.hpp"
 #include "engine/linear/condensed_solver.hpp"
+#include "engine/linear/dense_lu.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -37,6 +39,30 @@ Eigen::VectorXd factorizeAndSolve(CholmodSolver& solver, const Eigen::SparseMatr
 Eigen::MatrixXd symmetricPartOf(const Eigen::SparseMatrix<double>& a) {
   const Eigen::MatrixXd dense(a);
   return 0.5 * (dense + dense.transpose());
+}
+
+// The smallest systems (up to kSmallSystem unknowns) go to the dense LU; it solves a
+// non-symmetric system that needs row exchanges (a zero on the diagonal) to round-off, with new
+// values on the same pattern, and refuses a singular matrix.
+TEST(DenseFactorisation, SolvesSmallSystemsAndRefusesSingularOnes) {
+  const int n = kSmallSystem;
+  EXPECT_STREQ(makeSparseLu(n)->name(), "a dense LU");
+  EXPECT_STREQ(makeSparseLu(n + 1)->name(), "KLU");
+  DenseLu solver(n);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  for (const double diagonal : {0.0, 3.0}) {
+    const Eigen::SparseMatrix<double> a = bandedMatrix(n, diagonal, 0.5);
+    ASSERT_TRUE(solver.factorize(a, false));
+    Eigen::VectorXd x = rhs;
+    solver.solve(x);
+    // backward stable: the residual is round-off of |A| |x|
+    EXPECT_LT((a * x - rhs).norm(), 1e-13 * a.norm() * x.norm()) << "diagonal " << diagonal;
+  }
+  // two equal rows: singular
+  Eigen::MatrixXd dense = Eigen::MatrixXd(bandedMatrix(n, 3.0, 0.5));
+  dense.row(1) = dense.row(0);
+  const Eigen::SparseMatrix<double> singular = dense.sparseView();
+  EXPECT_FALSE(solver.factorize(singular, false));
 }
 
 TEST(SymmetricFactorisation, SolvesWithTheSymmetricPart) {

@@ -19,13 +19,15 @@ class SparseLu {
   virtual const char* name() const = 0;
 };
 
+// A dense LU for the smallest systems (lumped thermo-mechanical elements: 5-7 % less per step
+// than KLU at 7-16 unknowns, 25 % more at the 90 of a spatial slider-crank; docs/performance.md);
 // KLU (pivot reuse, no allocation) for small systems such as multibody and thermal networks;
 // UMFPACK with a fill-reducing ordering for the large systems of 3D solids, where KLU is
-// 20-60 times slower (docs/performance.md). A dense LU measured no faster than KLU on the
-// smallest systems (docs/performance.md, "Small systems"). With `symmetricPart`, a large system
-// gets CHOLMOD on its symmetric part, an approximation for simplified Newton (cholmod_solver.hpp).
+// 20-60 times slower. With `symmetricPart`, a large system gets CHOLMOD on its symmetric
+// part, an approximation for simplified Newton (cholmod_solver.hpp).
 std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false);
-// Systems of at least this many unknowns go to UMFPACK.
+// Systems of at least this many unknowns go to UMFPACK, of at most this many to a dense LU.
 inline constexpr int kLargeSystem = 3000;
+inline constexpr int kSmallSystem = 32;
 
 }  // namespace mpx
