@@ -5,7 +5,7 @@
 
 namespace mpx {
 
-DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1)
+DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1, bool withIncrement)
     : material_(&material),
       midpoint_(0.5 * (C0 + C1)),
       delta_(C1 - C0),
@@ -18,7 +18,9 @@ DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3&
   // the Gonzalez correction along dC restores directionality; G uses A:dS[B] = B:dS[A] of hyperelastic tangents
   const double defect = material.energyDifference(C0, C1) - 0.5 * stress_.cwiseProduct(delta_).sum();
   kappa_ = defect / squaredDelta_;
-  defectGradient_ = 0.5 * (material.stress(C1) - stress_) - 0.25 * material.stressIncrement(midpoint_, delta_);
+  // the numerator's gradient serves the increment only (a stress and a tangent evaluation)
+  if (withIncrement)
+    defectGradient_ = 0.5 * (material.stress(C1) - stress_) - 0.25 * material.stressIncrement(midpoint_, delta_);
   stress_ += 2.0 * kappa_ * delta_;
 }
 

@@ -18,8 +18,9 @@ inline constexpr double kStressQuotientSwitch = 1e-8;
 
 class DiscreteStress {
  public:
-  // Keeps a pointer to material, which must outlive this object.
-  DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1);
+  // Keeps a pointer to material, which must outlive this object. Without `withIncrement` (a
+  // residual-only evaluation) the stress alone: increment() must not be called.
+  DiscreteStress(const HyperelasticMaterial& material, const Mat3& C0, const Mat3& C1, bool withIncrement = true);
   // S~
   const Mat3& stress() const { return stress_; }
   // dS~/dC1 [H] for a symmetric direction H
@@ -27,13 +28,13 @@ class DiscreteStress {
 
  private:
   const HyperelasticMaterial* material_;
-  Mat3 midpoint_;        // Cm
-  Mat3 delta_;           // dC
-  Mat3 stress_;          // S~
-  Mat3 defectGradient_;  // G: derivative of the quotient's numerator N with respect to C1
-  double squaredDelta_;  // D = dC:dC
-  double kappa_ = 0.0;   // N / D
-  bool tiny_;            // below the quotient switch
+  Mat3 midpoint_;                       // Cm
+  Mat3 delta_;                          // dC
+  Mat3 stress_;                         // S~
+  Mat3 defectGradient_ = Mat3::Zero();  // G: derivative of the quotient's numerator N with respect to C1 (if asked)
+  double squaredDelta_;                 // D = dC:dC
+  double kappa_ = 0.0;                  // N / D
+  bool tiny_;                           // below the quotient switch
 };
 
 }  // namespace mpx

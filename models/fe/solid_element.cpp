@@ -270,7 +270,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
     const Mat3 F0 = x0 * G, F1 = x1 * G;
     if (!(F1.determinant() > 0.0)) return rejectInadmissible(out);
     const Mat3 C0 = F0.transpose() * F0, C1 = F1.transpose() * F1;
-    const DiscreteStress discrete(*spec_.material, C0, C1);
+    const DiscreteStress discrete(*spec_.material, C0, C1, args.tangent);
     PointEvaluation e{0.5 * (F0 + F1), 0.5, F1, discrete.stress()};
     e.strainFactor = 0.25;
     e.gammaFactor = 0.5;
@@ -290,7 +290,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
     double couplingShift = 0.0;
     Mat3 entropyRateGradient = Mat3::Zero();
     if (spec_.thermal) {
-      coupling.emplace(*coupling_, C0, C1);
+      coupling.emplace(*coupling_, C0, C1, args.tangent);
       e.temperature = pointTemperature(q, nodes);
       e.temperatureSlope = spec_.points[q].values.cwiseProduct(nodes.slope);
       e.couplingStress = coupling->stress();

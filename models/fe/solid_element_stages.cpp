@@ -263,8 +263,7 @@ void SolidElement::addStagePoint(const StageArgs& args, int l, const StagePoint&
 
   // A position or viscous-strain column of stage `column`: the positions move row `row` of F
   // by g (the path by d; row -1: they stay), the viscous strain by dGamma.
-  auto addColumn = [&](int localColumn, int row, const Eigen::RowVector3d& g, const PathChange& d,
-                       const Mat3& dGamma) {
+  auto addColumn = [&](int localColumn, int row, const Eigen::RowVector3d& g, const PathChange& d, const Mat3& dGamma) {
     const bool moves = row >= 0;
     Mat3 dStress = moves ? elastic.change(d, l) : Mat3::Zero();
     Mat3 dBranch = Mat3::Zero();
@@ -289,7 +288,8 @@ void SolidElement::addStagePoint(const StageArgs& args, int l, const StagePoint&
     for (int a = 0; a < nodes_; ++a) K.block<3, 1>(momentumRow + 3 * a, localColumn) += dPiola * G.row(a).transpose();
   };
   for (int b = 0; b < nodes_; ++b)
-    for (int i = 0; i < 3; ++i) addColumn(3 * b + i, i, G.row(b), pathChange(path, rule, column, i, G.row(b)), Mat3::Zero());
+    for (int i = 0; i < 3; ++i)
+      addColumn(3 * b + i, i, G.row(b), pathChange(path, rule, column, i, G.row(b)), Mat3::Zero());
   if (branch)
     for (int m = 0; m < 6; ++m) {
       Mat3 dGamma = Mat3::Zero();
