@@ -137,23 +137,28 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     ConstraintVector force = ConstraintVector::Zero(n), dForceDLambda = ConstraintVector::Zero(n),
                      rateRow = ConstraintVector::Zero(n);
     ConstraintMatrix dForce = ConstraintMatrix::Zero(n, n);
-    double rateOfPhi = 0.0;
+    // the Hessian's share of dForce, summed over the points before it multiplies H
+    double hessianWeight = 0.0, rateOfPhi = 0.0;
     for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
       const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-      const double phi = form.value(q), test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
+      // Phi = q.(H q + 2 g)/2 + c from the gradient H q + g
       const ConstraintVector gradient = form.gradientAt(q);
+      const double phi = 0.5 * q.dot(gradient + form.gradient) + form.constant;
+      const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
       const double value = multiplier + spec_.stiffness * phi, valueCoefficient = rule.fineValue[p][column + 1];
       force += (test * value) * gradient;
-      dForce += (test * valueCoefficient) * (value * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+      if (held) rateOfPhi += test * gradient.dot(rate);
+      if (!args.tangent) continue;
+      hessianWeight += test * valueCoefficient * value;
+      dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
       if (!held) continue;
       dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-      rateOfPhi += test * gradient.dot(rate);
       rateRow += test * (valueCoefficient * form.hessian * rate + rule.fineRate[p][column + 1] * gradient);
     }
     r.segment(n, n) += force;
-    K.block(n, 0, n, n) += dForce;
+    if (args.tangent) K.block(n, 0, n, n) += dForce + hessianWeight * form.hessian;
     if (!augmented()) continue;
     // mu is not used (mu = 0), nor lambda of an implied form
     const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
