@@ -18,7 +18,21 @@ QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
     : Component(spec.name, collectDofs(spec)),
       spec_(std::move(spec)),
       positionCount_(static_cast<int>(spec_.positionDofs.size())),
-      implied_(spec_.forms.size(), false) {}
+      implied_(spec_.forms.size(), false),
+      hessianEntries_(spec_.forms.size()) {
+  for (std::size_t k = 0; k < spec_.forms.size(); ++k) {
+    const ConstraintMatrix& H = spec_.forms[k].hessian;
+    for (int column = 0; column < H.cols(); ++column)
+      for (int row = 0; row < H.rows(); ++row)
+        if (H(row, column) != 0.0) hessianEntries_[k].push_back({row, column, H(row, column)});
+  }
+}
+
+ConstraintVector QuadraticConstraint::hessianTimes(std::size_t k, const ConstraintVector& v) const {
+  ConstraintVector product = ConstraintVector::Zero(positionCount_);
+  for (const HessianEntry& e : hessianEntries_[k]) product[e.row] += e.value * v[e.column];
+  return product;
+}
 
 ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
   ConstraintVector q(positionCount_);
@@ -33,7 +47,7 @@ double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
 void QuadraticConstraint::measure(const double* z, Measures& out) const {
   const ConstraintVector q = gather(z, 0);
   for (std::size_t k = 0; k < spec_.forms.size(); ++k) {
-    const double phi = spec_.forms[k].value(q);
+    const double phi = valueAt(k, q);
     out.energy += multiplier(z, k) * phi + 0.5 * spec_.stiffness * phi * phi;
     out.constraintViolation = std::max(out.constraintViolation, std::abs(phi));
   }
@@ -48,11 +62,13 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
     // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi
-    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.value(q0) + form.value(q1));
-    const ConstraintVector gradientMid = form.gradientAt(qMid);
+    const ConstraintVector gradientEnd = gradientAt(k, q1), gradientMid = gradientAt(k, qMid);
+    const double phiEnd = valueAt(k, q1, gradientEnd);
+    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (valueAt(k, q0) + phiEnd);
     r.segment(n, n) += force * gradientMid;
-    K.block(n, 0, n, n) +=
-        0.5 * force * form.hessian + (0.5 * spec_.stiffness) * gradientMid * form.gradientAt(q1).transpose();
+    if (args.tangent)
+      K.block(n, 0, n, n) +=
+          0.5 * force * form.hessian + (0.5 * spec_.stiffness) * gradientMid * gradientEnd.transpose();
     if (!augmented()) continue;
     // mu is not used by EEM (mu = 0), nor lambda of an implied form
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
@@ -65,8 +81,8 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
     }
     // lambda's row: the constraint at the end of the step
     K.block(n, lambda, n, 1) += gradientMid;
-    r[lambda] = form.value(q1);
-    K.block(lambda, 0, 1, n) = form.gradientAt(q1).transpose();
+    r[lambda] = phiEnd;
+    K.block(lambda, 0, 1, n) = gradientEnd.transpose();
   }
 }
 
@@ -77,8 +93,9 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
   auto K = out.tangent();
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const double force = multiplier(args.z, k) + spec_.stiffness * form.value(q);
-    const ConstraintVector gradient = form.gradientAt(q);
+    const ConstraintVector gradient = gradientAt(k, q);
+    const double phi = valueAt(k, q, gradient);
+    const double force = multiplier(args.z, k) + spec_.stiffness * phi;
     r.segment(n, n) += force * gradient;
     K.block(n, 0, n, n) += args.alpha * (force * form.hessian + spec_.stiffness * gradient * gradient.transpose());
     if (!augmented()) continue;
@@ -97,10 +114,10 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     r.head(n) += muValue * gradient;
     K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;
     K.block(0, mu, n, 1) += args.alpha * gradient;
-    r[lambda] = form.value(q);
+    r[lambda] = phi;
     K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
     r[mu] = gradient.dot(v);
-    K.block(mu, 0, 1, n) = args.alpha * (form.hessian * v).transpose();
+    K.block(mu, 0, 1, n) = args.alpha * hessianTimes(k, v).transpose();
     K.block(mu, n, 1, n) = args.alpha * gradient.transpose();
   }
 }
@@ -143,9 +160,8 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
       const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-      // Phi = q.(H q + 2 g)/2 + c from the gradient H q + g
-      const ConstraintVector gradient = form.gradientAt(q);
-      const double phi = 0.5 * q.dot(gradient + form.gradient) + form.constant;
+      const ConstraintVector gradient = gradientAt(k, q);
+      const double phi = valueAt(k, q, gradient);
       const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
       const double value = multiplier + spec_.stiffness * phi, valueCoefficient = rule.fineValue[p][column + 1];
       force += (test * value) * gradient;
@@ -155,7 +171,7 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
       dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
       if (!held) continue;
       dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-      rateRow += test * (valueCoefficient * form.hessian * rate + rule.fineRate[p][column + 1] * gradient);
+      rateRow += test * (valueCoefficient * hessianTimes(k, rate) + rule.fineRate[p][column + 1] * gradient);
     }
     r.segment(n, n) += force;
     if (args.tangent) K.block(n, 0, n, n) += dForce + hessianWeight * form.hessian;
@@ -174,8 +190,9 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
     // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
     if (l == 0) {
-      r[lambdaRow] = form.value(qEnd);
-      K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * form.gradientAt(qEnd).transpose();
+      const ConstraintVector gradientEnd = gradientAt(k, qEnd);
+      r[lambdaRow] = valueAt(k, qEnd, gradientEnd);
+      K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * gradientEnd.transpose();
     } else {
       r[lambdaRow] = rateOfPhi / args.dt;
       K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;

@@ -79,10 +79,27 @@ class QuadraticConstraint final : public Component {
   // lambda_k (0 for penalty).
   double multiplier(const double* z, std::size_t k) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
+  // Form k's H_k v, Phi_k(q) and grad Phi_k(q) from H_k's nonzeros: a joint's or a director's
+  // condition touches a few of the 24 coordinates, and the stage form evaluates them at four
+  // points per stage.
+  ConstraintVector hessianTimes(std::size_t k, const ConstraintVector& v) const;
+  ConstraintVector gradientAt(std::size_t k, const ConstraintVector& q) const {
+    return hessianTimes(k, q) + spec_.forms[k].gradient;
+  }
+  // (with grad Phi_k(q) already at hand: Phi = q.(H q + 2 g)/2 + c)
+  double valueAt(std::size_t k, const ConstraintVector& q, const ConstraintVector& gradient) const {
+    return 0.5 * q.dot(gradient + spec_.forms[k].gradient) + spec_.forms[k].constant;
+  }
+  double valueAt(std::size_t k, const ConstraintVector& q) const { return valueAt(k, q, gradientAt(k, q)); }
 
+  struct HessianEntry {
+    int row, column;
+    double value;
+  };
   ConstraintSpec spec_;
   int positionCount_;
-  std::vector<bool> implied_;  // per form: multipliers held at zero
+  std::vector<bool> implied_;                              // per form: multipliers held at zero
+  std::vector<std::vector<HessianEntry>> hessianEntries_;  // per form: the nonzeros of H_k
 };
 
 }  // namespace mpx
