@@ -97,7 +97,10 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     const double phi = valueAt(k, q, gradient);
     const double force = multiplier(args.z, k) + spec_.stiffness * phi;
     r.segment(n, n) += force * gradient;
-    K.block(n, 0, n, n) += args.alpha * (force * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+    // the n x n blocks of the tangent only where it has a z-part (not in IDA's residual calls)
+    const bool positionTangent = args.alpha != 0.0;
+    if (positionTangent)
+      K.block(n, 0, n, n) += args.alpha * (force * form.hessian + spec_.stiffness * gradient * gradient.transpose());
     if (!augmented()) continue;
     // GGL (index 2): M v' + (lambda + kappa Phi) G^T = f, q' - v + mu G^T = 0, Phi = 0, G v = 0
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
@@ -112,7 +115,7 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     }
     K.block(n, lambda, n, 1) += args.alpha * gradient;
     r.head(n) += muValue * gradient;
-    K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;
+    if (positionTangent) K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;
     K.block(0, mu, n, 1) += args.alpha * gradient;
     r[lambda] = phi;
     K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
