@@ -141,9 +141,9 @@ void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
       if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] += it.value();
     for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
       const auto [i, kinematicEntry] = kinematicColumns_[term];
+      const double factor = k[kinematicEntry] / k[pivotEntry_[i]];
       for (SparseMatrix::InnerIterator it(tangent, velocityOf(i)); it; ++it)
-        if (!isPosition(static_cast<int>(it.row())))
-          condensedColumn_[reducedIndex_[it.row()]] -= it.value() * k[kinematicEntry] / k[pivotEntry_[i]];
+        if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] -= it.value() * factor;
     }
     const int target = reducedIndex_[column];
     for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e) {
