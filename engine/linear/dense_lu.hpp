@@ -1,8 +1,8 @@
 #pragma once
 // Dense LU with partial pivoting (Eigen) for the smallest condensed systems, where KLU's
 // bookkeeping (pivot reuse checks, scaling, sparse triangular solves) costs more than the
-// arithmetic of a dense factorisation (docs/performance.md, "Small systems"). Storage is
-// allocated once for the system's size.
+// arithmetic of a dense factorisation (docs/performance.md, "Leaner evaluations, a stage
+// predictor and a dense LU for tiny systems"). Storage is allocated once for the system's size.
 #include "engine/linear/sparse_lu.hpp"
 
 #include <Eigen/Dense>
