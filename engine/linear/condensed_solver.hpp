@@ -28,8 +28,10 @@ class CondensedSolver {
  public:
   // `pattern`: the fixed pattern of every tangent this solver will see. `symmetricPart`: a large
   // condensed system is factorised by its symmetric part (an approximation, for simplified
-  // Newton only; engine/linear/cholmod_solver.hpp).
-  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern, bool symmetricPart = false);
+  // Newton only; engine/linear/cholmod_solver.hpp). `denseUpTo`: the largest condensed system
+  // factorised by a dense LU (engine/linear/sparse_lu.hpp).
+  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern, bool symmetricPart = false,
+                  int denseUpTo = kSmallSystem);
 
   // Factorise the condensed form of `tangent` (of the pattern given at construction). Its values
   // are kept, since solve reads its kinematic rows and velocity couplings: the tangent may be
@@ -37,7 +39,7 @@ class CondensedSolver {
   // Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
   // Forget the factorisation, its pivots and analysis: the next factorize starts as the first.
-  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_); }
+  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_, denseUpTo_); }
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Unknowns of the system actually factorised.
@@ -100,6 +102,7 @@ class CondensedSolver {
   GroupElimination internal_;
   Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
   bool symmetricPart_;
+  int denseUpTo_;
   std::unique_ptr<SparseLu> lu_;
 };
 

@@ -19,15 +19,20 @@ class SparseLu {
   virtual const char* name() const = 0;
 };
 
-// A dense LU for the smallest systems (lumped thermo-mechanical elements: 5-7 % less per step
-// than KLU at 7-16 unknowns, 25 % more at the 90 of a spatial slider-crank; docs/performance.md);
-// KLU (pivot reuse, no allocation) for small systems such as multibody and thermal networks;
-// UMFPACK with a fill-reducing ordering for the large systems of 3D solids, where KLU is
-// 20-60 times slower. With `symmetricPart`, a large system gets CHOLMOD on its symmetric
-// part, an approximation for simplified Newton (cholmod_solver.hpp).
-std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false);
-// Systems of at least this many unknowns go to UMFPACK, of at most this many to a dense LU.
+// Systems of at least this many unknowns go to UMFPACK. Of at most kSmallSystem to a dense LU;
+// a caller whose factorisations each serve many solves (IDA) takes it up to kManySolvesSystem.
 inline constexpr int kLargeSystem = 3000;
 inline constexpr int kSmallSystem = 32;
+inline constexpr int kManySolvesSystem = 200;
+
+// A dense LU for systems of up to `denseUpTo` unknowns (docs/performance.md: for the one-step
+// schemes' Newton, which factorises about once per step or more, 5-7 % less per step than KLU at
+// 7-16 unknowns and 20-25 % more at 90-160 multibody unknowns; for IDA, whose factorisations serve
+// tens of solves each, 12-33 % less per run at 69-158); KLU (pivot reuse, no allocation) for
+// small systems such as multibody and thermal networks; UMFPACK with a fill-reducing ordering
+// for the large systems of 3D solids, where KLU is 20-60 times slower. With `symmetricPart`, a
+// large system gets CHOLMOD on its symmetric part, an approximation for simplified Newton
+// (cholmod_solver.hpp).
+std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false, int denseUpTo = kSmallSystem);
 
 }  // namespace mpx

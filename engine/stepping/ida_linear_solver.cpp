@@ -52,8 +52,9 @@ int release(SUNLinearSolver solver) {
 SUNLinearSolver makeIdaLinearSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern,
                                     SUNContext context) {
   SUNLinearSolver solver = SUNLinSolNewEmpty(context);
-  auto* c = new Content{CondensedSolver(layout, pattern), pattern, Eigen::VectorXd(pattern.rows()),
-                        Eigen::VectorXd(pattern.rows())};
+  // IDA keeps a Newton matrix for many steps: its solves, not its factorisations, dominate
+  auto* c = new Content{CondensedSolver(layout, pattern, false, kManySolvesSystem), pattern,
+                        Eigen::VectorXd(pattern.rows()), Eigen::VectorXd(pattern.rows())};
   solver->content = c;
   solver->ops->gettype = type;
   solver->ops->getid = id;
