@@ -27,7 +27,7 @@ inline constexpr int kManySolvesSystem = 200;
 
 // A dense LU for systems of up to `denseUpTo` unknowns (docs/performance.md: for the one-step
 // schemes' Newton, which factorises about once per step or more, 5-7 % less per step than KLU at
-// 7-16 unknowns and 20-25 % more at 90-160 multibody unknowns; for IDA, whose factorisations serve
+// 7-16 unknowns and 20-25 % more at 106-158 multibody unknowns; for IDA, whose factorisations serve
 // tens of solves each, 12-33 % less per run at 69-158); KLU (pivot reuse, no allocation) for
 // small systems such as multibody and thermal networks; UMFPACK with a fill-reducing ordering
 // for the large systems of 3D solids, where KLU is 20-60 times slower. With `symmetricPart`, a
