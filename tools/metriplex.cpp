@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
   run->add_flag("--sundials-klu", request.sundialsKlu,
                 "ida: factorise the whole Newton matrix with SUNDIALS' KLU instead of Metriplex's solver (velocities "
-                "eliminated, then KLU, UMFPACK for large systems)");
+                "eliminated, then a dense LU, KLU or UMFPACK by size)");
   run->add_option("--dt-out", request.outputStep, "ida: output interval of history rows (default: --dt)");
   run->add_option("--checkpoint-every", request.checkpointEvery,
                   "one-step integrators: write DIR/checkpoint.txt every N steps (always at SIGINT/SIGTERM)");

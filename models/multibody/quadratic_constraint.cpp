@@ -156,7 +156,9 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     // the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
     ConstraintVector force = ConstraintVector::Zero(n), dForceDLambda = ConstraintVector::Zero(n),
                      rateRow = ConstraintVector::Zero(n);
-    ConstraintMatrix dForce = ConstraintMatrix::Zero(n, n);
+    // (the n x n block only where a tangent is wanted: residual-only passes are most of them)
+    ConstraintMatrix dForce;
+    if (args.tangent) dForce.setZero(n, n);
     // the Hessian's share of dForce, summed over the points before it multiplies H
     double hessianWeight = 0.0, rateOfPhi = 0.0;
     for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
