@@ -32,12 +32,14 @@ constexpr Variant kVariants[] = {{"predictor", true, 0.0, 0.0},
 
 class NewtonVariants : public ::testing::TestWithParam<const char*> {};
 
+constexpr int kSteps = 20;
+
 // Simplified Newton evaluates the residual alone at the iterates it does not factorise at; the
 // second- and fourth-order EEM steps both go through that path.
 TEST_P(NewtonVariants, ReachTheFullNewtonSolutionToTheTolerance) {
   const CompiledScene scene = loadScene(scenePath(GetParam()));
   const Model& model = *scene.model;
-  const double dt = scene.settings.dt, tEnd = 20 * dt;
+  const double dt = scene.settings.dt, tEnd = kSteps * dt;
   NewtonSettings full = scene.settings.newton;
   full.predictor = false;
   full.reuseContraction = 0.0;
@@ -56,18 +58,21 @@ TEST_P(NewtonVariants, ReachTheFullNewtonSolutionToTheTolerance) {
       settings.reuseBelowIncrement = v.reuseBelowIncrement;
       const History h = run(model, scheme, dt, tEnd, settings);
       ASSERT_FALSE(h.summary.failed) << v.name << ": " << h.summary.failure;
-      // 20 steps, each solved to an increment of 1e-10 relative: the states agree to 1e-8
+      // kSteps steps, each solved to an increment of 1e-10 relative: the states agree to 1e-8
       const double difference =
           ((h.states.back() - reference.states.back()).head(withScale).array() / magnitude.head(withScale).array())
               .abs()
               .maxCoeff();
       EXPECT_LT(difference, 1e-8) << v.name;
       EXPECT_LT(h.summary.maxEnergyBalanceError, 1e-9) << v.name;
-      // what each variant is for: fewer factorisations than iterations when they are kept
+      // what each variant is for: fewer factorisations than iterations when they are kept;
+      // full Newton factorises at every iteration but the last of a step, whose correction the
+      // factorisation in hand gives within the tolerance
       if (v.reuseContraction > 0.0 || v.reuseBelowIncrement > 0.0) {
         EXPECT_LT(h.summary.factorizations, h.summary.newtonIterations) << v.name;
       } else {
-        EXPECT_EQ(h.summary.factorizations, h.summary.newtonIterations) << v.name;
+        EXPECT_GE(h.summary.factorizations, h.summary.newtonIterations - kSteps) << v.name;
+        EXPECT_LT(h.summary.factorizations, h.summary.newtonIterations) << v.name;
       }
       // keeping the factorisation near the solution costs at most one more iteration in ten steps
       if (v.reuseBelowIncrement > 0.0 && v.reuseContraction == 0.0 && !v.predictor) {

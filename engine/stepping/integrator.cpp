@@ -167,6 +167,15 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     // full step near the solution, where the residual is already at round-off level); if no
     // step decreases it, a kept factorisation is refreshed, then the reused pivots are
     // replaced, before the step counts as failed
+    // Once the residual passes its test, the factorisation in hand is tried before a fresh
+    // one: a correction it gives within the increment tolerance is the last, applied with a
+    // residual-only evaluation (the converged iterate is as accurate as after a fresh Newton step)
+    bool last = false;
+    if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
+      solver_.solve(system.residual(), increment_);
+      last = relativeNorm(increment_, zNew) <= settings_.incrementTolerance;
+      refresh = !last;
+    }
     double step = 1.0;
     for (bool repivot = false;;) {
       if (refresh && !tangentAtIterate) {
@@ -176,20 +185,21 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
       }
       if (refresh && !refactorize(dt, repivot, outcome))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
-      solver_.solve(system.residual(), increment_);
-      step = lineSearch(zOld, t, dt, zNew, residualNorm, !simplified);
+      if (!last) solver_.solve(system.residual(), increment_);
+      step = lineSearch(zOld, t, dt, zNew, residualNorm, !simplified && !last);
       if (step > 0.0) break;
       if (refresh && repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
       repivot = refresh;
       refresh = true;
+      last = false;
       tangentAtIterate = false;  // the trials replaced the evaluation at zNew
     }
     zNew.swap(trial_);
-    tangentAtIterate = !simplified;
+    tangentAtIterate = !simplified && !last;
     ++outcome.iterations;
     const double previousIncrementNorm = incrementNorm;
-    incrementNorm = step * (increment_.array().abs() / (zNew.array().abs() + incrementScale_.array())).maxCoeff();
+    incrementNorm = step * relativeNorm(increment_, zNew);
     residualNorm = rescaledNorm(system);
     // keep the factorisation while the iteration contracts well (or has converged); full Newton
     // keeps it too once the increment is small: a tangent taken that close to the solution
@@ -200,6 +210,10 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
                   : incrementNorm > settings_.incrementTolerance &&
                         !(incrementNorm <= settings_.reuseContraction * previousIncrementNorm);
   }
+}
+
+double Integrator::relativeNorm(const Eigen::VectorXd& increment, const Eigen::VectorXd& z) const {
+  return (increment.array().abs() / (z.array().abs() + incrementScale_.array())).maxCoeff();
 }
 
 void Integrator::extrapolateStages(double dt) {
