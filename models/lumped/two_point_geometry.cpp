@@ -86,7 +86,7 @@ void TwoPointGeometry::addForceTangent(LocalSystem& local, const Vec3& direction
   auto K = local.tangent();
   for (const End& end : ends_)
     for (int k = 0; k < end.point.terms; ++k)
-      K.middleRows(end.localVelocity + 3 * k, 3) += (end.sign * end.point.weights[k]) * direction * dForce;
+      K.middleRows(end.localVelocity + 3 * k, 3).noalias() += ((end.sign * end.point.weights[k]) * direction) * dForce;
 }
 
 void TwoPointGeometry::addSeparationTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDd) const {
