@@ -103,20 +103,18 @@ AffineVector JointBuilder::difference(const AffineVector& u, const AffineVector&
 
 QuadraticForm JointBuilder::component(const AffineVector& v, int k) const {
   const auto n = static_cast<Eigen::Index>(dofs_.size());
-  QuadraticForm form;
-  form.hessian.setZero(n, n);
-  form.gradient = v.linear.row(k).transpose();
-  form.constant = v.offset[k];
-  return form;
+  return {ConstraintMatrix::Zero(n, n), v.linear.row(k).transpose(), v.offset[k]};
+}
+
+JointBuilder::DenseQuadratic JointBuilder::product(const AffineVector& u, const AffineVector& v) {
+  // (U q + u0).(V q + v0) = 1/2 q.(U^T V + V^T U) q + (U^T v0 + V^T u0).q + u0.v0
+  return {u.linear.transpose() * v.linear + v.linear.transpose() * u.linear,
+          u.linear.transpose() * v.offset + v.linear.transpose() * u.offset, u.offset.dot(v.offset)};
 }
 
 QuadraticForm JointBuilder::dot(const AffineVector& u, const AffineVector& v, double target) const {
-  // (U q + u0).(V q + v0) = 1/2 q.(U^T V + V^T U) q + (U^T v0 + V^T u0).q + u0.v0
-  QuadraticForm form;
-  form.hessian = u.linear.transpose() * v.linear + v.linear.transpose() * u.linear;
-  form.gradient = u.linear.transpose() * v.offset + v.linear.transpose() * u.offset;
-  form.constant = u.offset.dot(v.offset) - target;
-  return form;
+  const DenseQuadratic p = product(u, v);
+  return {p.hessian, p.gradient, p.constant - target};
 }
 
 std::vector<QuadraticForm> JointBuilder::joint(JointType type, const JointGeometry& g) const {
@@ -191,12 +189,10 @@ std::vector<QuadraticForm> JointBuilder::coordinateInvariants(JointType type, co
     std::vector<QuadraticForm> forms;
     for (int k = 0; k < 3; ++k) {
       const int i = (k + 1) % 3, j = (k + 2) % 3;
-      QuadraticForm s = dot(direction(0, Vec3::Unit(j)), direction(1, Vec3::Unit(i)), 0.0);
-      const QuadraticForm t = dot(direction(0, Vec3::Unit(i)), direction(1, Vec3::Unit(j)), 0.0);
-      s.hessian = 0.5 * (s.hessian - t.hessian);
-      s.gradient = 0.5 * (s.gradient - t.gradient);
-      s.constant = 0.5 * (s.constant - t.constant);
-      forms.push_back(std::move(s));
+      const DenseQuadratic s = product(direction(0, Vec3::Unit(j)), direction(1, Vec3::Unit(i)));
+      const DenseQuadratic t = product(direction(0, Vec3::Unit(i)), direction(1, Vec3::Unit(j)));
+      forms.emplace_back(0.5 * (s.hessian - t.hessian), 0.5 * (s.gradient - t.gradient),
+                         0.5 * (s.constant - t.constant));
     }
     return forms;
   }

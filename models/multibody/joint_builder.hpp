@@ -71,6 +71,13 @@ class JointBuilder {
   AffineVector direction(int side, const Vec3& worldDirection) const;
   QuadraticForm component(const AffineVector& v, int k) const;
   QuadraticForm dot(const AffineVector& u, const AffineVector& v, double target) const;
+  // u(q).v(q) as 1/2 q.H q + g.q + c
+  struct DenseQuadratic {
+    ConstraintMatrix hessian;
+    ConstraintVector gradient;
+    double constant;
+  };
+  static DenseQuadratic product(const AffineVector& u, const AffineVector& v);
   AffineVector difference(const AffineVector& u, const AffineVector& v) const;
 
   Attachment sides_[2];

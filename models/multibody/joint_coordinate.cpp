@@ -41,7 +41,7 @@ ConstraintVector JointCoordinate::gather(const double* z, int shift) const {
 
 Vec3 JointCoordinate::invariantsAt(const ConstraintVector& q) const {
   Vec3 I = Vec3::Zero();
-  for (std::size_t a = 0; a < invariants_.size(); ++a) I[a] = invariants_[a].value(q);
+  for (std::size_t a = 0; a < invariants_.size(); ++a) I[a] = invariants_[a].valueAt(q);
   return I;
 }
 

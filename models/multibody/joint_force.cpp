@@ -56,7 +56,7 @@ ConstraintVector JointForce::gather(const double* z, int shift) const {
 Vec3 JointForce::arguments(const double* z) const {
   const ConstraintVector q = gather(z, 0);
   Vec3 args = Vec3::Zero();
-  for (std::size_t a = 0; a < spec_.invariants.size(); ++a) args[a] = spec_.invariants[a].value(q);
+  for (std::size_t a = 0; a < spec_.invariants.size(); ++a) args[a] = spec_.invariants[a].valueAt(q);
   if (localInternal_ >= 0) args[kInternal] = z[spec_.internalDof];
   return args;
 }
@@ -200,7 +200,7 @@ void JointForce::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Fl
   // tangent w.r.t. q1 through I1 in the discrete gradients, the rate, and grad I(q_mid)
   K.block(n_, 0, n_, n_) += JMid.transpose() * (dEnergy.dGradDb + force * dCoordinate.dGradDb) * J1 +
                             JMid.transpose() * dCoordinate.grad * dForceDq;
-  for (int a = 0; a < m; ++a) K.block(n_, 0, n_, n_) += 0.5 * forceOnArguments[a] * spec_.invariants[a].hessian;
+  for (int a = 0; a < m; ++a) spec_.invariants[a].addHessian(0.5 * forceOnArguments[a], K.block(n_, 0, n_, n_));
 
   // Maxwell branch: nu (gamma' - gamma)/dt = -D_gamma e, dissipating (D_gamma e)^2 / nu
   double power = force * rate;
@@ -231,7 +231,7 @@ double JointForce::addDissipativeForce(const Vec3& a, const ConstraintVector& v,
   const double rate = angle.grad.dot(invariantRate);
   // d rate/dq through I (Hessian of the coordinate) and through J (Hessians of I); d rate/dv
   ConstraintRow dRateDq = (angle.hess * invariantRate).transpose() * J;
-  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * (spec_.invariants[i].hessian * v).transpose();
+  for (int i = 0; i < m; ++i) dRateDq += angle.grad[i] * spec_.invariants[i].hessianTimes(v).transpose();
   const ConstraintRow dRateDv = angle.grad.transpose() * J;
   double dForce = 0.0;
   double force = dissipativeForce(rate, &dForce);
@@ -249,7 +249,7 @@ double JointForce::addDissipativeForce(const Vec3& a, const ConstraintVector& v,
   out.residual().segment(n_, n_) += force * direction;
   K.block(n_, 0, n_, n_) += alpha * (force * J.transpose() * angle.hess * J + direction * dForceDq);
   K.block(n_, n_, n_, n_) += alpha * direction * dForceDv;
-  for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += (alpha * force * angle.grad[i]) * spec_.invariants[i].hessian;
+  for (int i = 0; i < m; ++i) spec_.invariants[i].addHessian(alpha * force * angle.grad[i], K.block(n_, 0, n_, n_));
   dPowerDq = alpha * (rate * dForceDq + force * dRateDq);
   dPowerDv = alpha * (rate * dForceDv + force * dRateDv);
   return force * rate;
@@ -265,7 +265,7 @@ void JointForce::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, F
   auto K = out.tangent();
   r.segment(n_, n_) += J.transpose() * e.grad;
   K.block(n_, 0, n_, n_) += args.alpha * J.transpose() * e.hess * J;
-  for (int i = 0; i < m; ++i) K.block(n_, 0, n_, n_) += args.alpha * e.grad[i] * spec_.invariants[i].hessian;
+  for (int i = 0; i < m; ++i) spec_.invariants[i].addHessian(args.alpha * e.grad[i], K.block(n_, 0, n_, n_));
   // the coordinate rate from the velocities, not from the position rates: under constraints the
   // GGL kinematic rows make q' = v - mu dPhi/dq, and a stiff damper on q' would amplify the
   // index-2 multiplier mu into the momentum rows (docs/theory.md section 6.2)
@@ -315,7 +315,7 @@ void JointForce::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out,
     // a'_j through the rates (coefficient rule.rate) and, for I, through grad I on its own stage
     for (int i = 0; i < 3; ++i) path.rateRows[j][i] = rule.rate[j][column + 1] * path.rows[j][i];
     if (j == column)
-      for (int i = 0; i < m; ++i) path.rateRows[j][i].head(n_) += (spec_.invariants[i].hessian * qRate).transpose();
+      for (int i = 0; i < m; ++i) path.rateRows[j][i].head(n_) += spec_.invariants[i].hessianTimes(qRate).transpose();
   }
   const GradientRows dEnergy =
       consistentGradient([&](const Vec3& a) { return energy(a); }, mask(), Vec3::Ones(), rule, path, l);
@@ -329,7 +329,7 @@ void JointForce::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out,
   r.segment(n_, n_) += J.transpose() * dEnergy.grad;
   for (int i = 0; i < m; ++i) {
     K.block(n_, 0, n_, out.n) += J.row(i).transpose() * dEnergy.d[i];
-    if (own) K.block(n_, 0, n_, n_) += dEnergy.grad[i] * spec_.invariants[i].hessian;
+    if (own) spec_.invariants[i].addHessian(dEnergy.grad[i], K.block(n_, 0, n_, n_));
   }
   ConstraintRow dPowerDq, dPowerDv;
   double power =

@@ -18,21 +18,7 @@ QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
     : Component(spec.name, collectDofs(spec)),
       spec_(std::move(spec)),
       positionCount_(static_cast<int>(spec_.positionDofs.size())),
-      implied_(spec_.forms.size(), false),
-      hessianEntries_(spec_.forms.size()) {
-  for (std::size_t k = 0; k < spec_.forms.size(); ++k) {
-    const ConstraintMatrix& H = spec_.forms[k].hessian;
-    for (int column = 0; column < H.cols(); ++column)
-      for (int row = 0; row < H.rows(); ++row)
-        if (H(row, column) != 0.0) hessianEntries_[k].push_back({row, column, H(row, column)});
-  }
-}
-
-ConstraintVector QuadraticConstraint::hessianTimes(std::size_t k, const ConstraintVector& v) const {
-  ConstraintVector product = ConstraintVector::Zero(positionCount_);
-  for (const HessianEntry& e : hessianEntries_[k]) product[e.row] += e.value * v[e.column];
-  return product;
-}
+      implied_(spec_.forms.size(), false) {}
 
 ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
   ConstraintVector q(positionCount_);
@@ -47,7 +33,7 @@ double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
 void QuadraticConstraint::measure(const double* z, Measures& out) const {
   const ConstraintVector q = gather(z, 0);
   for (std::size_t k = 0; k < spec_.forms.size(); ++k) {
-    const double phi = valueAt(k, q);
+    const double phi = spec_.forms[k].valueAt(q);
     out.energy += multiplier(z, k) * phi + 0.5 * spec_.stiffness * phi * phi;
     out.constraintViolation = std::max(out.constraintViolation, std::abs(phi));
   }
@@ -62,13 +48,14 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
     // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi
-    const ConstraintVector gradientEnd = gradientAt(k, q1), gradientMid = gradientAt(k, qMid);
-    const double phiEnd = valueAt(k, q1, gradientEnd);
-    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (valueAt(k, q0) + phiEnd);
+    const ConstraintVector gradientEnd = form.gradientAt(q1), gradientMid = form.gradientAt(qMid);
+    const double phiEnd = form.valueAt(q1, gradientEnd);
+    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.valueAt(q0) + phiEnd);
     r.segment(n, n) += force * gradientMid;
-    if (args.tangent)
-      K.block(n, 0, n, n) +=
-          0.5 * force * form.hessian + (0.5 * spec_.stiffness) * gradientMid * gradientEnd.transpose();
+    if (args.tangent) {
+      K.block(n, 0, n, n).noalias() += (0.5 * spec_.stiffness) * gradientMid * gradientEnd.transpose();
+      form.addHessian(0.5 * force, K.block(n, 0, n, n));
+    }
     if (!augmented()) continue;
     // mu is not used by EEM (mu = 0), nor lambda of an implied form
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
@@ -93,14 +80,16 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
   auto K = out.tangent();
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const ConstraintVector gradient = gradientAt(k, q);
-    const double phi = valueAt(k, q, gradient);
+    const ConstraintVector gradient = form.gradientAt(q);
+    const double phi = form.valueAt(q, gradient);
     const double force = multiplier(args.z, k) + spec_.stiffness * phi;
     r.segment(n, n) += force * gradient;
     // the n x n blocks of the tangent only where it has a z-part (not in IDA's residual calls)
     const bool positionTangent = args.alpha != 0.0;
-    if (positionTangent)
-      K.block(n, 0, n, n) += args.alpha * (force * form.hessian + spec_.stiffness * gradient * gradient.transpose());
+    if (positionTangent) {
+      K.block(n, 0, n, n).noalias() += (args.alpha * spec_.stiffness) * gradient * gradient.transpose();
+      form.addHessian(args.alpha * force, K.block(n, 0, n, n));
+    }
     if (!augmented()) continue;
     // GGL (index 2): M v' + (lambda + kappa Phi) G^T = f, q' - v + mu G^T = 0, Phi = 0, G v = 0
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
@@ -115,12 +104,12 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     }
     K.block(n, lambda, n, 1) += args.alpha * gradient;
     r.head(n) += muValue * gradient;
-    if (positionTangent) K.block(0, 0, n, n) += args.alpha * muValue * form.hessian;
+    if (positionTangent) form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
     K.block(0, mu, n, 1) += args.alpha * gradient;
     r[lambda] = phi;
     K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
     r[mu] = gradient.dot(v);
-    K.block(mu, 0, 1, n) = args.alpha * hessianTimes(k, v).transpose();
+    K.block(mu, 0, 1, n) = args.alpha * form.hessianTimes(v).transpose();
     K.block(mu, n, 1, n) = args.alpha * gradient.transpose();
   }
 }
@@ -165,8 +154,8 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
       const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-      const ConstraintVector gradient = gradientAt(k, q);
-      const double phi = valueAt(k, q, gradient);
+      const ConstraintVector gradient = form.gradientAt(q);
+      const double phi = form.valueAt(q, gradient);
       const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
       const double value = multiplier + spec_.stiffness * phi, valueCoefficient = rule.fineValue[p][column + 1];
       force += (test * value) * gradient;
@@ -176,10 +165,13 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
       dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
       if (!held) continue;
       dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-      rateRow += test * (valueCoefficient * hessianTimes(k, rate) + rule.fineRate[p][column + 1] * gradient);
+      rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
     }
     r.segment(n, n) += force;
-    if (args.tangent) K.block(n, 0, n, n) += dForce + hessianWeight * form.hessian;
+    if (args.tangent) {
+      K.block(n, 0, n, n) += dForce;
+      form.addHessian(hessianWeight, K.block(n, 0, n, n));
+    }
     if (!augmented()) continue;
     // mu is not used (mu = 0), nor lambda of an implied form
     const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
@@ -195,8 +187,8 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
     // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
     if (l == 0) {
-      const ConstraintVector gradientEnd = gradientAt(k, qEnd);
-      r[lambdaRow] = valueAt(k, qEnd, gradientEnd);
+      const ConstraintVector gradientEnd = form.gradientAt(qEnd);
+      r[lambdaRow] = form.valueAt(qEnd, gradientEnd);
       K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * gradientEnd.transpose();
     } else {
       r[lambdaRow] = rateOfPhi / args.dt;

@@ -15,25 +15,11 @@
 // stages' test functions with a quadrature exact for their polynomial integrands, so that the
 // constraint forces do no work over the step and the penalty energy's change is exact.
 #include "engine/core/component.hpp"
+#include "models/multibody/quadratic_form.hpp"
 
 #include <vector>
 
 namespace mpx {
-
-// Largest number of position dofs one constraint set couples (two rigid bodies).
-inline constexpr int kMaxConstrainedDofs = 24;
-using ConstraintVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstrainedDofs, 1>;
-using ConstraintMatrix =
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
-using ConstraintRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxConstrainedDofs>;
-
-struct QuadraticForm {
-  ConstraintMatrix hessian;
-  ConstraintVector gradient;
-  double constant = 0.0;
-  double value(const ConstraintVector& q) const { return 0.5 * q.dot(hessian * q) + gradient.dot(q) + constant; }
-  ConstraintVector gradientAt(const ConstraintVector& q) const { return hessian * q + gradient; }
-};
 
 enum class Enforcement { Penalty, AugmentedLagrangian };
 
@@ -79,27 +65,9 @@ class QuadraticConstraint final : public Component {
   // lambda_k (0 for penalty).
   double multiplier(const double* z, std::size_t k) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
-  // Form k's H_k v, Phi_k(q) and grad Phi_k(q) from H_k's nonzeros: a joint's or a director's
-  // condition touches a few of the 24 coordinates, and the stage form evaluates them at four
-  // points per stage.
-  ConstraintVector hessianTimes(std::size_t k, const ConstraintVector& v) const;
-  ConstraintVector gradientAt(std::size_t k, const ConstraintVector& q) const {
-    return hessianTimes(k, q) + spec_.forms[k].gradient;
-  }
-  // (with grad Phi_k(q) already at hand: Phi = q.(H q + 2 g)/2 + c)
-  double valueAt(std::size_t k, const ConstraintVector& q, const ConstraintVector& gradient) const {
-    return 0.5 * q.dot(gradient + spec_.forms[k].gradient) + spec_.forms[k].constant;
-  }
-  double valueAt(std::size_t k, const ConstraintVector& q) const { return valueAt(k, q, gradientAt(k, q)); }
-
-  struct HessianEntry {
-    int row, column;
-    double value;
-  };
   ConstraintSpec spec_;
   int positionCount_;
-  std::vector<bool> implied_;                              // per form: multipliers held at zero
-  std::vector<std::vector<HessianEntry>> hessianEntries_;  // per form: the nonzeros of H_k
+  std::vector<bool> implied_;  // per form: multipliers held at zero
 };
 
 }  // namespace mpx

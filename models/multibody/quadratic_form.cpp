@@ -1,0 +1,18 @@
+#include "models/multibody/quadratic_form.hpp"
+
+namespace mpx {
+
+QuadraticForm::QuadraticForm(const ConstraintMatrix& hessian, ConstraintVector gradient, double constant)
+    : gradient_(std::move(gradient)), constant_(constant) {
+  for (int column = 0; column < hessian.cols(); ++column)
+    for (int row = 0; row < hessian.rows(); ++row)
+      if (hessian(row, column) != 0.0) entries_.push_back({row, column, hessian(row, column)});
+}
+
+ConstraintVector QuadraticForm::hessianTimes(const ConstraintVector& v) const {
+  ConstraintVector product = ConstraintVector::Zero(gradient_.size());
+  for (const Entry& e : entries_) product[e.row] += e.value * v[e.column];
+  return product;
+}
+
+}  // namespace mpx

@@ -1,0 +1,50 @@
+#pragma once
+// A quadratic function of the coordinates of at most two rigid bodies (position and three
+// directors each: 24), phi(q) = 1/2 q.H q + g.q + c. Joint conditions, director rigidity and
+// joint invariants are all of this kind in the director formulation (docs/theory.md sections
+// 6-7). A condition touches a few of the 24 coordinates, so H is kept as its nonzeros and every
+// product goes through them.
+#include <Eigen/Dense>
+
+#include <vector>
+
+namespace mpx {
+
+// Largest number of position dofs one constraint set couples (two rigid bodies).
+inline constexpr int kMaxConstrainedDofs = 24;
+using ConstraintVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstrainedDofs, 1>;
+using ConstraintMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
+using ConstraintRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxConstrainedDofs>;
+
+class QuadraticForm {
+ public:
+  // H symmetric, of the size of g.
+  QuadraticForm(const ConstraintMatrix& hessian, ConstraintVector gradient, double constant);
+
+  // H v
+  ConstraintVector hessianTimes(const ConstraintVector& v) const;
+  // grad phi(q) = H q + g
+  ConstraintVector gradientAt(const ConstraintVector& q) const { return hessianTimes(q) + gradient_; }
+  // phi(q); with grad phi(q) at hand, phi = q.(grad phi(q) + g)/2 + c
+  double valueAt(const ConstraintVector& q, const ConstraintVector& gradientAtQ) const {
+    return 0.5 * q.dot(gradientAtQ + gradient_) + constant_;
+  }
+  double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
+  // K += factor H, for K (an expression of) the n x n block of the coordinates
+  template <class Block>
+  void addHessian(double factor, Block&& K) const {
+    for (const Entry& e : entries_) K(e.row, e.column) += factor * e.value;
+  }
+
+ private:
+  struct Entry {
+    int row, column;
+    double value;
+  };
+  std::vector<Entry> entries_;  // H's nonzeros, by column
+  ConstraintVector gradient_;
+  double constant_;
+};
+
+}  // namespace mpx
