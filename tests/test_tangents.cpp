@@ -2,7 +2,8 @@
 // scheme (EEM with both discrete-gradient forms, eem4's stage system, midpoint, trapezoidal) on
 // small scenes that
 // together hold every scene element, in both thermal variables, and the components' rate form
-// alpha dF/dz + beta dF/dzdot for arbitrary alpha, beta.
+// alpha dF/dz + beta dF/dzdot for arbitrary alpha, beta; and the quadratic forms of joints.
+#include "models/multibody/quadratic_form.hpp"
 #include "support.hpp"
 #include "tangent_check.hpp"
 
@@ -316,6 +317,34 @@ TEST(RateTangent, MatchesSeparateFiniteDifferencesInStateAndRate) {
                                beta * centralDifferences(inRate, zdot, magnitude, 1e-6);
       expectTangentMatches(model, assembleRate(model, z, zdot, alpha, beta).tangent, numeric, magnitude, kTolerance);
     }
+}
+
+// A constraint or invariant form keeps only its Hessian's nonzeros: its value, gradient and
+// Hessian equal those of the dense quadratic it was built from (a symmetric H with zero rows and
+// columns, as a joint condition touches few of the 24 coordinates), and the gradient and
+// Hessian are central differences of the value and gradient (exact for a quadratic).
+TEST(QuadraticFormTangent, MatchesTheDenseFormAndItsFiniteDifferences) {
+  constexpr int n = 12;
+  ConstraintMatrix H = ConstraintMatrix::Zero(n, n);
+  const VectorXd entries = randomIsh(VectorXd::Ones(n * n), 17);
+  for (int i = 0; i < n; i += 2)
+    for (int j = 0; j <= i; j += 3) H(i, j) = H(j, i) = entries[i * n + j];
+  const ConstraintVector g = randomIsh(VectorXd::Ones(n), 19);
+  const double c = 0.3;
+  const QuadraticForm form(H, g, c);
+  const ConstraintVector q = randomIsh(VectorXd::Ones(n), 23);
+
+  EXPECT_NEAR(form.valueAt(q), 0.5 * q.dot(H * q) + g.dot(q) + c, 1e-14);
+  EXPECT_LT((form.gradientAt(q) - (H * q + g)).cwiseAbs().maxCoeff(), 1e-14);
+  MatrixXd hessian = MatrixXd::Zero(n, n);
+  form.addHessian(1.0, hessian);
+  EXPECT_EQ(hessian, MatrixXd(H));
+
+  const auto gradient = [&](const VectorXd& x) { return VectorXd(form.gradientAt(x)); };
+  EXPECT_LT((centralDifferences(gradient, q, VectorXd::Ones(n), 1e-4) - hessian).cwiseAbs().maxCoeff(), 1e-9);
+  // the value's change along a direction, against the gradient at the midpoint (exact for a quadratic)
+  const ConstraintVector d = randomIsh(VectorXd::Ones(n), 29);
+  EXPECT_NEAR(form.valueAt(q + d) - form.valueAt(q - d), 2.0 * form.gradientAt(q).dot(d), 1e-12);
 }
 
 }  // namespace
