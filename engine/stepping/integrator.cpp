@@ -163,10 +163,6 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     }
     if (iteration == settings_.maxIterations)
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
-    // backtrack along the Newton direction until the residual is finite and decreases (a
-    // full step near the solution, where the residual is already at round-off level); if no
-    // step decreases it, a kept factorisation is refreshed, then the reused pivots are
-    // replaced, before the step counts as failed
     // Once the residual passes its test, the factorisation in hand is tried before a fresh
     // one: a correction it gives within the increment tolerance is the last, applied with a
     // residual-only evaluation (the converged iterate is as accurate as after a fresh Newton step)
@@ -176,6 +172,10 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
       last = relativeNorm(increment_, zNew) <= settings_.incrementTolerance;
       refresh = !last;
     }
+    // backtrack along the Newton direction until the residual is finite and decreases (a
+    // full step near the solution, where the residual is already at round-off level); if no
+    // step decreases it, a kept factorisation is refreshed, then the reused pivots are
+    // replaced, before the step counts as failed
     double step = 1.0;
     for (bool repivot = false;;) {
       if (refresh && !tangentAtIterate) {
