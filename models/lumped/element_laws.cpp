@@ -39,15 +39,13 @@ Jet HookeLaw::energy(const Vec3& args) const {
 Jet HookeLaw::entropy(const Vec3&) const { return Jet{}; }
 
 ThermoElasticLaw::ThermoElasticLaw(const ThermoElasticParameters& parameters, ThermalVariable variable)
-    : p_(parameters), variable_(variable) {
+    : p_(parameters), variable_(variable), logRestLength_(std::log(parameters.restLength)) {
   if (variable_ == ThermalVariable::Entropy && p_.stiffnessCurvature != 0.0)
     throw std::invalid_argument(
         "the entropy-based formulation needs a stiffness linear in temperature (stiffness_curvature = 0)");
 }
 
-double ThermoElasticLaw::logStrain(double c) const {
-  return p_.hasStretch ? 0.5 * std::log(c) - std::log(p_.restLength) : 0.0;
-}
+double ThermoElasticLaw::logStrain(double c) const { return p_.hasStretch ? 0.5 * std::log(c) - logRestLength_ : 0.0; }
 
 Jet ThermoElasticLaw::toStretchInvariant(const Jet& h, double c) const {
   if (!p_.hasStretch) return h;

@@ -13,6 +13,9 @@ class ElementLaw {
   virtual ~ElementLaw() = default;
   virtual Jet energy(const Vec3& args) const = 0;
   virtual Jet entropy(const Vec3& args) const = 0;
+  // True when the entropy is linear in the arguments: then every discrete gradient of it is
+  // its constant gradient, and elements skip the quotients (and their round-off).
+  virtual bool linearEntropy() const { return false; }
 };
 
 // Isothermal spring with a Maxwell branch, in the elongation u = lambda - lambda0 (lambda = sqrt c):
@@ -23,6 +26,7 @@ class HookeLaw final : public ElementLaw {
   HookeLaw(double stiffness, double restLength, double branchStiffness);
   Jet energy(const Vec3& args) const override;
   Jet entropy(const Vec3& args) const override;
+  bool linearEntropy() const override { return true; }
 
  private:
   double stiffness_, restLength_, branchStiffness_;
@@ -56,6 +60,8 @@ class ThermoElasticLaw final : public ElementLaw {
   ThermoElasticLaw(const ThermoElasticParameters& parameters, ThermalVariable variable);
   Jet energy(const Vec3& args) const override;
   Jet entropy(const Vec3& args) const override;
+  // in entropy form the entropy argument is the entropy itself
+  bool linearEntropy() const override { return variable_ == ThermalVariable::Entropy; }
 
   // The state's thermal variable for a given temperature or entropy at stretch c and gamma.
   double thermalVariableFromTemperature(double c, double theta, double gamma) const;
@@ -72,6 +78,7 @@ class ThermoElasticLaw final : public ElementLaw {
 
   ThermoElasticParameters p_;
   ThermalVariable variable_;
+  double logRestLength_;
 };
 
 }  // namespace mpx

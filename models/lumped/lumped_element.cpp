@@ -30,6 +30,7 @@ LumpedElement::LumpedElement(LumpedElementSpec spec) : Component(spec.name, coll
     mask_ |= kInternalBit;
     localInternal_ = n - 1;
   }
+  linearEntropy_ = spec_.law->linearEntropy();
 }
 
 Vec3 LumpedElement::arguments(const double* z) const {
@@ -53,6 +54,13 @@ GradientRows LumpedElement::alongRows(const DiscreteGradient& gradient, const Lo
   GradientRows out;
   out.grad = gradient.grad;
   for (int i = 0; i < 3; ++i) out.d[i] = chain(gradient.dGradDb.row(i).transpose(), rows);
+  return out;
+}
+
+GradientRows LumpedElement::constantGradient(const Jet& linear) const {
+  GradientRows out;
+  out.grad = linear.grad;
+  for (auto& row : out.d) row.setZero(static_cast<int>(dofs().size()));
   return out;
 }
 
@@ -115,10 +123,12 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
   auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
   auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
   const bool gonzalez = spec_.form == DiscreteGradientForm::Gonzalez;
-  const DiscreteGradient dEnergy = gonzalez ? gonzalezGradient(energy, mask_, a, b, spec_.argumentScale)
-                                            : partitionedGradient(energy, mask_, a, b, spec_.argumentScale);
-  const DiscreteGradient dEntropy = gonzalez ? gonzalezGradient(entropy, mask_, a, b, spec_.argumentScale)
-                                             : partitionedGradient(entropy, mask_, a, b, spec_.argumentScale);
+  auto discreteGradient = [&](const auto& f) {
+    return gonzalez ? gonzalezGradient(f, mask_, a, b, spec_.argumentScale)
+                    : partitionedGradient(f, mask_, a, b, spec_.argumentScale);
+  };
+  const DiscreteGradient dEnergy = discreteGradient(energy);
+  const DiscreteGradient dEntropy = linearEntropy_ ? exactGradient(entropy(b)) : discreteGradient(entropy);
 
   // derivatives of the end-point arguments b with respect to zNew
   LocalRow rows[3];
@@ -202,7 +212,9 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
   auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
   const GradientRows dEnergy = consistentGradient(energy, mask_, spec_.argumentScale, *args.rule, path, l);
-  const GradientRows dEntropy = consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
+  const GradientRows dEntropy = linearEntropy_
+                                    ? constantGradient(entropy(path.end))
+                                    : consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
   Response response = respond(dEnergy, dEntropy);
   // at steps far too long for the motion the stage temperature can leave (0, inf): that is no
   // solution (its heat would lower the entropy), so the residual is made non-finite and Newton
