@@ -317,5 +317,31 @@ TEST(LawThermodynamics, EntropyFormIsTheTemperatureFormAtEqualEntropy) {
   }
 }
 
+// A law that declares its entropy linear is taken at its word: the elements then use the
+// entropy's gradient for every discrete and stage gradient. It must be constant with a zero
+// Hessian, and both discrete gradients must reduce to it exactly; the temperature form, whose
+// entropy is logarithmic in theta, must not declare it.
+TEST(LawThermodynamics, ALinearEntropyHasOneGradientThatEveryDiscreteGradientReturns) {
+  const std::vector<std::shared_ptr<const ElementLaw>> linear = {
+      std::make_shared<HookeLaw>(3.0, 1.0, 2.0),
+      std::make_shared<ThermoElasticLaw>(thermoParameters(0.0, 0.0), ThermalVariable::Entropy),
+      std::make_shared<ThermoElasticLaw>(thermoParameters(2.0, 0.0), ThermalVariable::Entropy),
+      std::make_shared<ThermoElasticLaw>(reservoirParameters(), ThermalVariable::Entropy)};
+  const Vec3 a(2.25, 0.3, 0.1), b(2.5, 0.45, 0.05);
+  for (const auto& law : linear) {
+    ASSERT_TRUE(law->linearEntropy());
+    const Jet atA = law->entropy(a), atB = law->entropy(b);
+    EXPECT_EQ(atA.grad, atB.grad);
+    EXPECT_EQ(atA.hess.norm(), 0.0);
+    EXPECT_EQ(atB.value - atA.value, atA.grad.dot(b - a));
+    for (Form form : {Form::Partitioned, Form::Gonzalez}) {
+      const DiscreteGradient d = discreteGradient(form, entropyOf(law), 0b111u, a, b, Vec3::Ones());
+      EXPECT_EQ(d.grad, atA.grad) << formName(form);
+      EXPECT_EQ(d.dGradDb.norm(), 0.0) << formName(form);
+    }
+  }
+  EXPECT_FALSE(ThermoElasticLaw(thermoParameters(0.0, 0.0), ThermalVariable::Temperature).linearEntropy());
+}
+
 }  // namespace
 }  // namespace mpx
