@@ -107,8 +107,10 @@ TEST(RefinedLBlock, EemConservesEnergyAndMomentaAtLevelTwo) {
 // time kappa L^2 / k0 (16 cells: the stiffest mode decays 1000 times faster). EEM keeps the
 // energy balance with the boundary heat, produces entropy at every step and keeps every
 // temperature above the initial one and bounded (it overshoots the held 500 K: the scheme has no
-// maximum principle at such steps); midpoint destroys entropy in some step and trapezoidal
-// drives a temperature below zero, where the entropy is not finite, so its run stops there.
+// maximum principle at such steps). Midpoint and trapezoidal each leave physics: they destroy
+// entropy in some step or drive a temperature below zero, where the entropy is not finite, so
+// that the run stops there (which of the two depends on the Newton start, i.e. on the predictor,
+// since the schemes' equations have unphysical roots at such steps).
 const char* const kHotBar = R"(<metriplex name="hot_bar"><simulation dt="1" t_end="20"/>
   <solid name="bar" mesh="box" size="1 0.1 0.1" cells="16 1 1" young="1000" poisson="0.3" density="1"
          heat_capacity="1" conductivity="1" expansion="1e-3" reference_temperature="273" temperature="273"/>
@@ -137,22 +139,29 @@ HotBarFigures hotBarFigures(const CompiledScene& scene, const History& h) {
 
 TEST(HotBarHard, EemStaysPhysicalAtAStepOfTheDiffusionTime) {
   const CompiledScene scene = loadSceneText(kHotBar, "hot_bar.xml");
-  const HotBarFigures eem = hotBarFigures(scene, run(*scene.model, Scheme::Eem, 1.0, 20.0));
-  const HotBarFigures midpoint = hotBarFigures(scene, run(*scene.model, Scheme::Midpoint, 1.0, 20.0));
+  const History eemRun = run(*scene.model, Scheme::Eem, 1.0, 20.0);
+  const History midpointRun = run(*scene.model, Scheme::Midpoint, 1.0, 20.0);
   const History trapezoidalRun = run(*scene.model, Scheme::Trapezoidal, 1.0, 20.0);
-  const HotBarFigures trapezoidal = hotBarFigures(scene, trapezoidalRun);
-  for (const auto& [name, f] : {std::pair{"EEM", eem}, {"midpoint", midpoint}, {"trapezoidal", trapezoidal}})
-    std::printf("%-12s temperatures in [%.1f, %.1f] K, least production %.2e, balance error %.2e\n", name, f.lowest,
-                f.highest, f.leastProduction, f.balance);
+  const HotBarFigures eem = hotBarFigures(scene, eemRun);
+  for (const auto& [name, h] :
+       {std::pair{"EEM", &eemRun}, {"midpoint", &midpointRun}, {"trapezoidal", &trapezoidalRun}}) {
+    const HotBarFigures f = hotBarFigures(scene, *h);
+    std::printf("%-12s temperatures in [%.1f, %.1f] K, least production %.2e, balance error %.2e%s\n", name, f.lowest,
+                f.highest, f.leastProduction, f.balance, h->summary.failed ? " (stopped)" : "");
+    if (h == &eemRun) continue;
+    // a standard scheme destroys entropy, or stops at a temperature below zero
+    if (h->summary.failed)
+      EXPECT_NE(h->summary.failure.find("is not finite"), std::string::npos) << name << ": " << h->summary.failure;
+    else
+      EXPECT_LT(f.leastProduction, 0.0) << name;
+  }
+  EXPECT_FALSE(eemRun.summary.failed);
   EXPECT_GE(eem.lowest, 273.0 - 1e-9);
   // bounded, but not by the maximum principle: at this step the stiff modes alternate
   // (amplification near -1), so EEM overshoots 500 K (about 727 K here)
   EXPECT_LT(eem.highest, 1000.0);
   EXPECT_GE(eem.leastProduction, 0.0);
   EXPECT_LT(eem.balance, 1e-10 * 500.0 * 0.01);  // heat capacity 0.01 J/K: about 2.3 J cross
-  EXPECT_LT(midpoint.leastProduction, 0.0);
-  ASSERT_TRUE(trapezoidalRun.summary.failed);
-  EXPECT_NE(trapezoidalRun.summary.failure.find("is not finite"), std::string::npos) << trapezoidalRun.summary.failure;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // Newton variants (engine/stepping/integrator): the predictor (start from the extrapolation of
-// the last two states), simplified Newton (a factorisation kept while the increments contract)
+// the last states), simplified Newton (a factorisation kept while the increments contract)
 // and full Newton that keeps its factorisation close to the solution change how the step's
 // equations are solved, never which equations: each run reaches the full-Newton solution to
 // the Newton tolerance and keeps the energy balance.
@@ -168,7 +168,7 @@ TEST(SimplifiedNewton, KeepsItsFactorisationAcrossSmallStepChangesOnly) {
 
 // The predictor saves iterations where the trajectory is smooth: the two thermo-springs in
 // temperature form take 4.05 iterations per step from the old state over t in [0, 20] and
-// 3.5 from the extrapolation (4.02 and 3.03 over t in [0, 2000]).
+// 3.25 from the extrapolation (4.02 and 2.29 over t in [0, 2000]).
 TEST(NewtonPredictor, SavesIterationsOnASmoothTrajectory) {
   const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"), ThermalVariable::Temperature);
   NewtonSettings off = scene.settings.newton, on = off;
@@ -178,6 +178,27 @@ TEST(NewtonPredictor, SavesIterationsOnASmoothTrajectory) {
   const History with = run(*scene.model, Scheme::Eem, 0.2, 20.0, on);
   EXPECT_LT(with.summary.newtonIterations, 0.9 * without.summary.newtonIterations)
       << with.summary.newtonIterations << " against " << without.summary.newtonIterations;
+}
+
+// The one-stage schemes' predictor is the parabola through the last three states (after two
+// steps, and while it comes closer than the line through two): a mass falling under gravity
+// moves on a parabola, which EEM, midpoint and trapezoidal all reproduce exactly at any step, so
+// from the third step on the predicted state is the solution and each step takes one Newton
+// iteration (the line misses by g dt^2 and takes two), to the same states.
+TEST(NewtonPredictor, ParabolaPredictsAFreeFallExactly) {
+  const CompiledScene scene = loadSceneText(R"(<metriplex name="fall"><simulation dt="0.1" t_end="2"/>
+      <gravity g="0 0 -9.81"/><mass name="m" mass="2" position="0 0 0" velocity="1 0 3"/></metriplex>)",
+                                            "fall.xml");
+  NewtonSettings off = scene.settings.newton, on = off;
+  off.predictor = false;
+  on.predictor = true;
+  for (const Scheme scheme : {Scheme::Eem, Scheme::Midpoint, Scheme::Trapezoidal}) {
+    const History without = run(*scene.model, scheme, 0.1, 2.0, off);
+    const History with = run(*scene.model, scheme, 0.1, 2.0, on);
+    EXPECT_EQ(with.summary.newtonIterations, 2 * 2 + 18) << schemeName(scheme);
+    EXPECT_EQ(without.summary.newtonIterations, 2 * 20) << schemeName(scheme);
+    EXPECT_LT((with.states.back() - without.states.back()).cwiseAbs().maxCoeff(), 1e-12) << schemeName(scheme);
+  }
 }
 
 // eem4's predictor continues the last step's stage polynomial: its extrapolation weights on
