@@ -29,22 +29,6 @@ struct CollocationRule {
   std::array<std::array<double, kMostStages>, kFinePoints> fineStage{};
 };
 
-// The stage polynomial's extrapolation past the step's end: z(1 + x) = sum_l w[l] Z_l + w[s] z(1)
-// (tau = 1 + x in the old step's time), from the Lagrange basis on {c_1..c_s, 1}. The eem4
-// predictor starts the next step's stages there (Hairer & Wanner II, IV.8).
-inline std::array<double, CollocationRule::kMostStages + 1> extrapolationWeights(const CollocationRule& rule,
-                                                                                 double x) {
-  std::array<double, CollocationRule::kMostStages + 1> point{}, weight{};
-  for (int l = 0; l < rule.stages; ++l) point[l] = rule.node[l];
-  point[rule.stages] = 1.0;
-  for (int j = 0; j <= rule.stages; ++j) {
-    weight[j] = 1.0;
-    for (int m = 0; m <= rule.stages; ++m)
-      if (m != j) weight[j] *= (1.0 + x - point[m]) / (point[j] - point[m]);
-  }
-  return weight;
-}
-
 // The s-stage rule (s = 1, 2: orders 2, 4), from the Lagrange basis on {0, c_1..c_s}.
 inline CollocationRule gaussCollocation(int stages) {
   assert(stages >= 1 && stages <= CollocationRule::kMostStages);

@@ -1,5 +1,6 @@
 #include "engine/stepping/integrator.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -32,10 +33,9 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       zDot_(model.layout().total()),
       increment_(rule_.stages * model.layout().total()),
       trial_(rule_.stages * model.layout().total()),
-      halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())),
-      lastStart_(model.layout().total()),
-      lastEnd_(model.layout().total()),
-      lastBefore_(model.layout().total()) {
+      halfState_(settings.maxCutbacks + 1, Eigen::VectorXd(model.layout().total())) {
+  for (auto& state : pastStates_) state.resize(model.layout().total());
+  pastTimes_.fill(NAN);  // no past step: the first step starts from the old state
   const int n = model.layout().total(), withScale = model.layout().offset(Block::Multiplier);
   unknownScale_ = model.dofScale().replicate(rule_.stages, 1);
   incrementScale_ = unknownScale_;
@@ -45,7 +45,6 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
     stages_.resize(rule_.stages * n);
     stageRates_.resize(rule_.stages * n);
     stageEnd_.resize(n);
-    lastStages_.resize(rule_.stages * n);
   }
 }
 
@@ -217,41 +216,50 @@ double Integrator::relativeNorm(const Eigen::VectorXd& increment, const Eigen::V
   return (increment.array().abs() / (z.array().abs() + incrementScale_.array())).maxCoeff();
 }
 
-void Integrator::extrapolateStages(double dt) {
-  const int n = static_cast<int>(lastEnd_.size()), s = rule_.stages;
-  for (int l = 0; l < s; ++l) {
-    // from the increments over the last end state (the weights sum to one)
-    const std::array<double, CollocationRule::kMostStages + 1> weight =
-        extrapolationWeights(rule_, rule_.node[l] * dt / lastDt_);
-    auto stage = stages_.segment(l * n, n);
-    stage = lastEnd_;
-    for (int j = 0; j < s; ++j) stage += weight[j] * (lastStages_.segment(j * n, n) - lastEnd_);
-  }
-}
-
 bool Integrator::continuesLastStep(const Eigen::VectorXd& z, double t) const {
-  return std::abs(t - (lastTime_ + lastDt_)) <= 1e-12 * (std::abs(t) + lastDt_) && z == lastEnd_;
+  return pastCount_ >= 2 && std::abs(t - pastTimes_[0]) <= 1e-12 * (std::abs(t) + pastTimes_[0] - pastTimes_[1]) &&
+         z == pastStates_[0];
 }
 
-void Integrator::extrapolateState(double dt, bool parabola, Eigen::VectorXd& out) const {
-  const double h0 = lastDt_;
-  out = lastEnd_ + (dt / h0) * (lastEnd_ - lastStart_);
-  // Newton's form: z(t_n + tau) = z_n + tau [z_n, z_n-1] + tau (tau + h0) [z_n, z_n-1, z_n-2]
-  if (parabola) {
-    const double h1 = lastBeforeDt_;
-    out += (dt * (dt + h0) / (h0 + h1)) * ((lastEnd_ - lastStart_) / h0 - (lastStart_ - lastBefore_) / h1);
+// Newton's divided differences of the past states, component by component: the polynomial of
+// degree k is the sum of the first k + 1 terms, so every degree comes out of one pass.
+namespace {
+template <std::size_t N, class Visit>
+void forEachExtrapolation(const std::array<Eigen::VectorXd, N>& states, const std::array<double, N>& times, int degree,
+                          double time, Visit&& visit) {
+  double basis[N] = {1.0};
+  for (int k = 1; k <= degree; ++k) basis[k] = basis[k - 1] * (time - times[k - 1]);
+  for (Eigen::Index i = 0; i < states[0].size(); ++i) {
+    double difference[N] = {}, value[N] = {};
+    for (int k = 0; k <= degree; ++k) difference[k] = states[k][i];
+    for (int level = 1; level <= degree; ++level)
+      for (int k = degree; k >= level; --k)
+        difference[k] = (difference[k - 1] - difference[k]) / (times[k - level] - times[k]);
+    value[0] = difference[0];
+    for (int k = 1; k <= degree; ++k) value[k] = value[k - 1] + basis[k] * difference[k];
+    visit(i, value);
   }
 }
+}  // namespace
 
-void Integrator::choosePredictor(double dt, const Eigen::VectorXd& zNew) {
-  // the line wins where the steps do not resolve the motion (the L-block's 70 rad/s mode at
-  // dt 0.1), the parabola where they do; both misses in the increment test's norm
-  extrapolateState(dt, false, trial_);
-  increment_ = zNew - trial_;
-  const double lineMiss = relativeNorm(increment_, zNew);
-  extrapolateState(dt, true, trial_);
-  increment_ = zNew - trial_;
-  parabolaPredicts_ = relativeNorm(increment_, zNew) <= lineMiss;
+void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const {
+  const int degree = predictorDegree_;
+  forEachExtrapolation(pastStates_, pastTimes_, degree, time,
+                       [&](Eigen::Index i, const double* value) { out[i] = value[degree]; });
+}
+
+void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reached) {
+  // a higher degree wins where the steps resolve the motion, the line where they do not (the
+  // L-block's 70 rad/s mode at dt 0.1)
+  const int highest = pastCount_ - 1;
+  double miss[kPastStates] = {};
+  forEachExtrapolation(pastStates_, pastTimes_, highest, time, [&](Eigen::Index i, const double* value) {
+    const double weight = 1.0 / (std::abs(reached[i]) + incrementScale_[i]);
+    for (int k = 1; k <= highest; ++k) miss[k] = std::max(miss[k], std::abs(reached[i] - value[k]) * weight);
+  });
+  predictorDegree_ = 1;
+  for (int k = 2; k <= highest; ++k)
+    if (miss[k] < miss[predictorDegree_]) predictorDegree_ = k;
 }
 
 bool Integrator::refactorize(double dt, bool repivot, StepOutcome& outcome) {
@@ -281,12 +289,12 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
   // if Newton fails from there, it tries again from the old state before cutting back
   const bool continues = level == 0 && settings_.predictor && continuesLastStep(z, t);
   if (continues) {
-    const bool stagesGuessed = lastStagesKept_;
-    if (stagesGuessed)
-      extrapolateStages(dt);
+    const int n = static_cast<int>(z.size());
+    if (rule_.stages > 1)
+      for (int l = 0; l < rule_.stages; ++l) extrapolate(t + rule_.node[l] * dt, stages_.segment(l * n, n));
     else
-      extrapolateState(dt, lastBeforeKept_ && parabolaPredicts_, zNew);
-    if (solveStep(z, t, dt, zNew, outcome, stagesGuessed)) return true;
+      extrapolate(t + dt, zNew);
+    if (solveStep(z, t, dt, zNew, outcome, rule_.stages > 1)) return true;
     factorizedDt_ = 0.0;
   }
   zNew = z;
@@ -308,43 +316,43 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
   if (byComponent) std::fill(byComponent->begin(), byComponent->end(), Flows{});
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
   if (outcome.converged) {
-    // eem4: the stages of a step taken whole give the next step's guess
-    lastStagesKept_ = rule_.stages > 1 && outcome.cutbacks == 0;
-    if (lastStagesKept_) lastStages_ = stages_;
-    // one-stage schemes: three consecutive states give the parabola
-    const bool continued = continuesLastStep(z, t);
-    if (rule_.stages == 1 && continued && lastBeforeKept_) choosePredictor(dt, zNew);
-    lastBeforeKept_ = continued;
-    lastBefore_.swap(lastStart_);
-    lastBeforeDt_ = lastDt_;
-    lastStart_ = z;
-    lastEnd_ = zNew;
-    lastTime_ = t;
-    lastDt_ = dt;
+    // the past states: the new one first, after those it continues
+    if (continuesLastStep(z, t)) {
+      choosePredictorDegree(t + dt, zNew);
+      std::rotate(pastStates_.rbegin(), pastStates_.rbegin() + 1, pastStates_.rend());
+      std::rotate(pastTimes_.rbegin(), pastTimes_.rbegin() + 1, pastTimes_.rend());
+      pastCount_ = std::min(pastCount_ + 1, kPastStates);
+    } else {
+      pastStates_[1] = z;
+      pastTimes_[1] = t;
+      pastCount_ = 2;
+      predictorDegree_ = 1;
+    }
+    pastStates_[0] = zNew;
+    pastTimes_[0] = t + dt;
   }
   return outcome;
 }
 
 void Integrator::checkpoint(LoopState& out) {
-  out.predictorStart = lastStart_;
-  out.predictorEnd = lastEnd_;
-  out.predictorTime = lastTime_;
-  out.predictorDt = lastDt_;
+  out.predictorStart = pastStates_[1];
+  out.predictorEnd = pastStates_[0];
+  out.predictorTime = pastTimes_[1];
+  out.predictorDt = pastTimes_[0] - pastTimes_[1];
   solver_.startAfresh();
   factorizedDt_ = 0.0;
-  // the stage predictor and the state before the last step are not saved: the step after a
-  // checkpoint extrapolates linearly, in the run that wrote it as in a restart from it
-  lastStagesKept_ = lastBeforeKept_ = false;
-  parabolaPredicts_ = true;
+  // only the last step is saved: the run that writes a checkpoint continues from what a restart
+  // from it has (the last two states, the line, no stages)
+  resume(out);
 }
 
 void Integrator::resume(const LoopState& saved) {
-  lastStart_ = saved.predictorStart;
-  lastEnd_ = saved.predictorEnd;
-  lastTime_ = saved.predictorTime;
-  lastDt_ = saved.predictorDt;
-  lastStagesKept_ = lastBeforeKept_ = false;
-  parabolaPredicts_ = true;
+  pastStates_[1] = saved.predictorStart;
+  pastStates_[0] = saved.predictorEnd;
+  pastTimes_[1] = saved.predictorTime;
+  pastTimes_[0] = saved.predictorTime + saved.predictorDt;
+  pastCount_ = 2;  // a checkpoint before the first step holds no time: nothing continues it
+  predictorDegree_ = 1;
 }
 
 }  // namespace mpx

@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include <array>
 #include <cmath>
 
 #include <string>
@@ -97,16 +98,13 @@ class Integrator {
   // or, if stagesGuessed, from the stage values already in stages_).
   bool solveStep(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew, StepOutcome& outcome,
                  bool stagesGuessed = false);
-  // eem4: the last step's stage polynomial at this step's stages, into stages_.
-  void extrapolateStages(double dt);
   // True when a step from z at t continues the last accepted step.
   bool continuesLastStep(const Eigen::VectorXd& z, double t) const;
-  // One-stage schemes: the state dt past the last step on the line through its two states or,
-  // with `parabola`, on the parabola through those and lastBefore_.
-  void extrapolateState(double dt, bool parabola, Eigen::VectorXd& out) const;
-  // After a step that could have been predicted either way: which would have come closer to
-  // zNew decides the next step's predictor.
-  void choosePredictor(double dt, const Eigen::VectorXd& zNew);
+  // The polynomial of degree predictorDegree_ through the newest past states, at `time`.
+  void extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const;
+  // After a step that continued the past states: the degree whose polynomial came closest to
+  // the state it reached (in the increment test's norm) predicts the next step.
+  void choosePredictorDegree(double time, const Eigen::VectorXd& reached);
   bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
   // eem4: the stage rates and the end state of the stage polynomial, then its residual.
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
@@ -136,18 +134,13 @@ class Integrator {
   std::vector<Eigen::VectorXd> halfState_;          // one midpoint state per cut-back level
   // simplified Newton: the step size the factorisation belongs to (0: none held)
   double factorizedDt_ = 0.0;
-  // predictor: the last accepted step, lastStart_ at lastTime_ to lastEnd_ over lastDt_, and,
-  // if that step continued the one before (lastBeforeKept_), that one's start lastBefore_ over
-  // lastBeforeDt_
-  Eigen::VectorXd lastStart_, lastEnd_, lastBefore_;
-  double lastTime_ = NAN, lastDt_ = 0.0, lastBeforeDt_ = 0.0;
-  bool lastBeforeKept_ = false;
-  // one-stage schemes: the parabola through three states predicts the next step while it came
-  // closer to the last step's solution than the line through two
-  bool parabolaPredicts_ = true;
-  // eem4: the last step's stages, if it was taken whole, and which guess to start from
-  Eigen::VectorXd lastStages_;
-  bool lastStagesKept_ = false;
+  // predictor: the last accepted states, newest first, at their times; pastCount_ of them
+  // follow each other step by step (two or more: a step from pastStates_[0] continues them)
+  static constexpr int kPastStates = 4;
+  std::array<Eigen::VectorXd, kPastStates> pastStates_;
+  std::array<double, kPastStates> pastTimes_{};
+  int pastCount_ = 0;
+  int predictorDegree_ = 1;                    // of the polynomial through the past states (below pastCount_)
   std::vector<Flows>* byComponent_ = nullptr;  // of the advance under way, if asked for
 };
 
