@@ -43,6 +43,8 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
     incrementScale_.segment(l * n + withScale, n - withScale).setConstant(INFINITY);
   if (scheme == Scheme::Eem4) {
     stages_.resize(rule_.stages * n);
+    stagePrediction_.resize(rule_.stages * n);
+    stageMiss_.resize(rule_.stages * n);
     stageRates_.resize(rule_.stages * n);
     stageEnd_.resize(n);
   }
@@ -262,7 +264,8 @@ void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reach
     for (int k = 1; k <= highest; ++k) miss[k] = std::max(miss[k], std::abs(reached[i] - value[k]) * weight);
   });
   predictorDegree_ = 1;
-  if (miss[1] > kResolvedMiss) return;
+  motionResolved_ = miss[1] <= kResolvedMiss;
+  if (!motionResolved_) return;
   for (int k = 2; k <= highest; ++k)
     if (miss[k] < miss[predictorDegree_]) predictorDegree_ = k;
 }
@@ -295,10 +298,16 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
   const bool continues = level == 0 && settings_.predictor && continuesLastStep(z, t);
   if (continues) {
     const int n = static_cast<int>(z.size());
-    if (rule_.stages > 1)
+    if (rule_.stages > 1) {
       for (int l = 0; l < rule_.stages; ++l) extrapolate(t + rule_.node[l] * dt, stages_.segment(l * n, n));
-    else
+      // Gauss stages are of order 3 against the trajectory the ends are of order 4 on: where the
+      // steps resolve the motion, the last step's stage error, scaled as dt^3, is added
+      stagePrediction_ = stages_;
+      stagesPredicted_ = true;
+      if (stageMissKept_ && motionResolved_) stages_ += std::pow(dt / stageMissDt_, 3) * stageMiss_;
+    } else {
       extrapolate(t + dt, zNew);
+    }
     if (solveStep(z, t, dt, zNew, outcome, rule_.stages > 1)) return true;
     factorizedDt_ = 0.0;
   }
@@ -319,8 +328,15 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
   byComponent_ = byComponent;
   assembler_.keepComponentFlows(byComponent != nullptr);
   if (byComponent) std::fill(byComponent->begin(), byComponent->end(), Flows{});
+  stagesPredicted_ = false;
   outcome.converged = advanceLevel(z, t, dt, 0, zNew, outcome);
   if (outcome.converged) {
+    // eem4: the stage error of a step taken whole from a prediction
+    stageMissKept_ = stagesPredicted_ && outcome.cutbacks == 0;
+    if (stageMissKept_) {
+      stageMiss_ = stages_ - stagePrediction_;
+      stageMissDt_ = dt;
+    }
     // the past states: the new one first, after those it continues
     if (continuesLastStep(z, t)) {
       choosePredictorDegree(t + dt, zNew);
@@ -332,6 +348,7 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
       pastTimes_[1] = t;
       pastCount_ = 2;
       predictorDegree_ = 1;
+      motionResolved_ = false;
     }
     pastStates_[0] = zNew;
     pastTimes_[0] = t + dt;
@@ -358,6 +375,7 @@ void Integrator::resume(const LoopState& saved) {
   pastTimes_[0] = saved.predictorTime + saved.predictorDt;
   pastCount_ = 2;  // a checkpoint before the first step holds no time: nothing continues it
   predictorDegree_ = 1;
+  motionResolved_ = stageMissKept_ = false;
 }
 
 }  // namespace mpx

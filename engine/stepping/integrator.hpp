@@ -131,7 +131,12 @@ class Integrator {
   // have no natural scale; their rows' residual, the constraints, judges them)
   Eigen::VectorXd unknownScale_, incrementScale_;
   Eigen::VectorXd stages_, stageRates_, stageEnd_;  // eem4
-  std::vector<Eigen::VectorXd> halfState_;          // one midpoint state per cut-back level
+  // eem4's stage predictor: the polynomial's values at this step's stages, and the last step's
+  // stages minus that step's (over stageMissDt_), the stage error the polynomial does not see
+  Eigen::VectorXd stagePrediction_, stageMiss_;
+  bool stagesPredicted_ = false, stageMissKept_ = false;
+  double stageMissDt_ = 0.0;
+  std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
   // simplified Newton: the step size the factorisation belongs to (0: none held)
   double factorizedDt_ = 0.0;
   // predictor: the last accepted states, newest first, at their times; pastCount_ of them
@@ -141,6 +146,7 @@ class Integrator {
   std::array<double, kPastStates> pastTimes_{};
   int pastCount_ = 0;
   int predictorDegree_ = 1;                    // of the polynomial through the past states (below pastCount_)
+  bool motionResolved_ = false;                // the line came within kResolvedMiss of the last state reached
   std::vector<Flows>* byComponent_ = nullptr;  // of the advance under way, if asked for
 };
 
