@@ -300,8 +300,9 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
     const int n = static_cast<int>(z.size());
     if (rule_.stages > 1) {
       for (int l = 0; l < rule_.stages; ++l) extrapolate(t + rule_.node[l] * dt, stages_.segment(l * n, n));
-      // Gauss stages are of order 3 against the trajectory the ends are of order 4 on: where the
-      // steps resolve the motion, the last step's stage error, scaled as dt^3, is added
+      // the polynomial runs through step ends, accurate to dt^4, but Newton's target is the Gauss
+      // stages, which miss the trajectory by dt^3: where the steps resolve the motion, the last
+      // step's miss, scaled to this step, is added
       stagePrediction_ = stages_;
       stagesPredicted_ = true;
       if (stageMissKept_ && motionResolved_) stages_ += std::pow(dt / stageMissDt_, 3) * stageMiss_;
