@@ -57,13 +57,6 @@ GradientRows LumpedElement::alongRows(const DiscreteGradient& gradient, const Lo
   return out;
 }
 
-GradientRows LumpedElement::constantGradient(const Jet& linear) const {
-  GradientRows out;
-  out.grad = linear.grad;
-  for (auto& row : out.d) row.setZero(static_cast<int>(dofs().size()));
-  return out;
-}
-
 LumpedElement::Response LumpedElement::respond(const GradientRows& dEnergy, const GradientRows& dEntropy) const {
   const int n = static_cast<int>(dEnergy.d[0].size());
   Response r;
@@ -212,8 +205,9 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
   auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
   const GradientRows dEnergy = consistentGradient(energy, mask_, spec_.argumentScale, *args.rule, path, l);
+  // a linear entropy's stage gradient is its gradient (zero Hessian: zero rows)
   const GradientRows dEntropy = linearEntropy_
-                                    ? constantGradient(entropy(path.end))
+                                    ? alongRows(exactGradient(entropy(path.end)), path.endRows)
                                     : consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
   Response response = respond(dEnergy, dEntropy);
   // at steps far too long for the motion the stage temperature can leave (0, inf): that is no

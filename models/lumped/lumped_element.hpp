@@ -66,8 +66,6 @@ class LumpedElement final : public Component {
   static LocalRow chain(const Vec3& dArguments, const LocalRow (&rows)[3]);
   // A discrete gradient's derivative with respect to b, carried onto the local dofs.
   static GradientRows alongRows(const DiscreteGradient& gradient, const LocalRow (&rows)[3]);
-  // The stage gradient of a linear entropy: its gradient, with no derivative over the dofs.
-  GradientRows constantGradient(const Jet& linear) const;
   // The arguments along an eem4 step's stage polynomial, for the tangent block args.column.
   StagePath stagePath(const StageArgs& args) const;
   // Residual rows shared by all forms and the tangent terms through the response's
