@@ -223,31 +223,26 @@ bool Integrator::continuesLastStep(const Eigen::VectorXd& z, double t) const {
          z == pastStates_[0];
 }
 
-// Newton's divided differences of the past states, component by component: the polynomial of
-// degree k is the sum of the first k + 1 terms, so every degree comes out of one pass.
+// The weights of the past states in the polynomial of degree `degree` through the newest
+// degree + 1 of them, at `time` (Lagrange's basis): p(time) = sum_k weight_k z_k. The weights
+// cost O(degree^2) once, so each state entry costs degree + 1 multiply-adds.
 namespace {
-template <std::size_t N, class Visit>
-void forEachExtrapolation(const std::array<Eigen::VectorXd, N>& states, const std::array<double, N>& times, int degree,
-                          double time, Visit&& visit) {
-  double basis[N] = {1.0};
-  for (int k = 1; k <= degree; ++k) basis[k] = basis[k - 1] * (time - times[k - 1]);
-  for (Eigen::Index i = 0; i < states[0].size(); ++i) {
-    double difference[N] = {}, value[N] = {};
-    for (int k = 0; k <= degree; ++k) difference[k] = states[k][i];
-    for (int level = 1; level <= degree; ++level)
-      for (int k = degree; k >= level; --k)
-        difference[k] = (difference[k - 1] - difference[k]) / (times[k - level] - times[k]);
-    value[0] = difference[0];
-    for (int k = 1; k <= degree; ++k) value[k] = value[k - 1] + basis[k] * difference[k];
-    visit(i, value);
+template <std::size_t N>
+std::array<double, N> lagrangeWeights(const std::array<double, N>& times, int degree, double time) {
+  std::array<double, N> weight{};
+  for (int k = 0; k <= degree; ++k) {
+    weight[k] = 1.0;
+    for (int m = 0; m <= degree; ++m)
+      if (m != k) weight[k] *= (time - times[m]) / (times[k] - times[m]);
   }
+  return weight;
 }
 }  // namespace
 
 void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const {
-  const int degree = predictorDegree_;
-  forEachExtrapolation(pastStates_, pastTimes_, degree, time,
-                       [&](Eigen::Index i, const double* value) { out[i] = value[degree]; });
+  const auto weight = lagrangeWeights(pastTimes_, predictorDegree_, time);
+  out = weight[0] * pastStates_[0];
+  for (int k = 1; k <= predictorDegree_; ++k) out += weight[k] * pastStates_[k];
 }
 
 // A degree above one is chosen only where the line came within this of the last state reached:
@@ -258,11 +253,17 @@ constexpr double kResolvedMiss = 0.2;
 void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reached) {
   // each degree's miss in the increment test's norm, from one pass over the past states
   const int highest = pastCount_ - 1;
+  std::array<std::array<double, kPastStates>, kPastStates> weight{};
+  for (int k = 1; k <= highest; ++k) weight[k] = lagrangeWeights(pastTimes_, k, time);
   double miss[kPastStates] = {};
-  forEachExtrapolation(pastStates_, pastTimes_, highest, time, [&](Eigen::Index i, const double* value) {
-    const double weight = 1.0 / (std::abs(reached[i]) + incrementScale_[i]);
-    for (int k = 1; k <= highest; ++k) miss[k] = std::max(miss[k], std::abs(reached[i] - value[k]) * weight);
-  });
+  for (Eigen::Index i = 0; i < reached.size(); ++i) {
+    const double scale = 1.0 / (std::abs(reached[i]) + incrementScale_[i]);
+    for (int k = 1; k <= highest; ++k) {
+      double value = 0.0;
+      for (int j = 0; j <= k; ++j) value += weight[k][j] * pastStates_[j][i];
+      miss[k] = std::max(miss[k], std::abs(reached[i] - value) * scale);
+    }
+  }
   predictorDegree_ = 1;
   motionResolved_ = miss[1] <= kResolvedMiss;
   if (!motionResolved_) return;
