@@ -136,6 +136,11 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   // Simplified Newton's iterates need the residual alone while the factorisation is kept; the
   // tangent is evaluated where it is factorised.
   const bool simplified = settings_.reuseContraction > 0.0;
+  // Full Newton: where the last solve needed a single factorisation, the first iterate is
+  // probably the last to need a tangent (the next correction comes from the factorisation in
+  // hand), so its trial evaluates the residual alone; the tangent follows if it is needed after all
+  const bool tangentLikelyDone = oneFactorisationSufficed_;
+  const int factorisationsBefore = outcome.factorizations;
   bool refresh = !simplified || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
   bool tangentAtIterate = refresh;
   // the residual norm relative to row scales taken from the tangent at the current iterate
@@ -158,6 +163,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
   for (int iteration = 0;; ++iteration) {
     if (iteration > 0 && incrementNorm <= settings_.incrementTolerance && residualNorm <= settings_.residualTolerance) {
+      oneFactorisationSufficed_ = outcome.factorizations - factorisationsBefore == 1;
       outcome.energy += system.flows() * dt;
       if (byComponent_)
         for (std::size_t c = 0; c < byComponent_->size(); ++c) (*byComponent_)[c] += system.componentFlows()[c] * dt;
@@ -179,6 +185,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     // step decreases it, a kept factorisation is refreshed, then the reused pivots are
     // replaced, before the step counts as failed
     double step = 1.0;
+    bool tangentAtTrial = false;
     for (bool repivot = false;;) {
       if (refresh && !tangentAtIterate) {
         tangentAtIterate = true;
@@ -188,7 +195,8 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
       if (refresh && !refactorize(dt, repivot, outcome))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
       if (!last) solver_.solve(system.residual(), increment_);
-      step = lineSearch(zOld, t, dt, zNew, residualNorm, !simplified && !last);
+      tangentAtTrial = !simplified && !last && !(iteration == 0 && tangentLikelyDone);
+      step = lineSearch(zOld, t, dt, zNew, residualNorm, tangentAtTrial);
       if (step > 0.0) break;
       if (refresh && repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
@@ -198,7 +206,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
       tangentAtIterate = false;  // the trials replaced the evaluation at zNew
     }
     zNew.swap(trial_);
-    tangentAtIterate = !simplified && !last;
+    tangentAtIterate = tangentAtTrial;
     ++outcome.iterations;
     const double previousIncrementNorm = incrementNorm;
     incrementNorm = step * relativeNorm(increment_, zNew);

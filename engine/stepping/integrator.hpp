@@ -139,6 +139,7 @@ class Integrator {
   std::vector<Eigen::VectorXd> halfState_;  // one midpoint state per cut-back level
   // simplified Newton: the step size the factorisation belongs to (0: none held)
   double factorizedDt_ = 0.0;
+  bool oneFactorisationSufficed_ = false;  // the last Newton solve factorised once
   // predictor: the last accepted states, newest first, at their times; pastCount_ of them
   // follow each other step by step (two or more: a step from pastStates_[0] continues them)
   static constexpr int kPastStates = 4;
