@@ -38,9 +38,10 @@ Vec3 LumpedElement::arguments(const double* z) const {
           localInternal_ >= 0 ? z[spec_.internalDof] : 0.0};
 }
 
-void LumpedElement::argumentRows(const Vec3& separation, LocalRow (&rows)[3]) const {
-  const int n = static_cast<int>(dofs().size());
+void LumpedElement::argumentRows(const Vec3& separation, LocalRow (&rows)[3], bool tangent) const {
+  const int n = tangent ? static_cast<int>(dofs().size()) : 0;
   for (auto& row : rows) row.setZero(n);
+  if (!tangent) return;
   if (geometry_) geometry_->addSeparationRow(rows[0], 2.0 * separation);
   if (localThermal_ >= 0) rows[1][localThermal_] = 1.0;
   if (localInternal_ >= 0) rows[2][localInternal_] = 1.0;
@@ -86,28 +87,31 @@ void LumpedElement::addBalances(const Response& response, double zCoefficient, c
                                 Flows& flows) const {
   auto r = out.residual();
   auto K = out.tangent();
-  if (geometry_) {
-    geometry_->addForce(out, response.force * forceDirection);
-    geometry_->addForceTangent(out, forceDirection, zCoefficient * response.dForce);
-  }
+  // a response without derivatives (a residual-only evaluation) adds no tangent terms
+  const bool tangent = response.dTheta.size() > 0;
   const double g = response.drivingForce, nu = response.viscosity;
-  const LocalRow dDissipation = (2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity;
-  if (localInternal_ >= 0) {
-    r[localInternal_] += nu * gammaRate - g;
-    K.row(localInternal_) += zCoefficient * (gammaRate * response.dViscosity - response.dDrivingForce);
-  }
+  if (geometry_) geometry_->addForce(out, response.force * forceDirection);
+  if (localInternal_ >= 0) r[localInternal_] += nu * gammaRate - g;
   if (localThermal_ >= 0) {
     // the viscous power heats the element's own node
     const double heating = localInternal_ >= 0 ? g * g / nu : 0.0;
     r[localThermal_] += response.theta * entropyRate - heating;
-    K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta -
-                                            (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
     NodeTemperature& node = ws.nodes[spec_.thermalNode];
     node.value = response.theta;
-    node.count = out.n;
-    Eigen::Map<LocalRow>(node.grad, out.n) = zCoefficient * response.dTheta;
+    node.count = tangent ? out.n : 0;
   } else if (localInternal_ >= 0) {
     flows.dissipated += g * g / nu;
+  }
+  if (!tangent) return;
+
+  if (geometry_) geometry_->addForceTangent(out, forceDirection, zCoefficient * response.dForce);
+  if (localInternal_ >= 0)
+    K.row(localInternal_) += zCoefficient * (gammaRate * response.dViscosity - response.dDrivingForce);
+  if (localThermal_ >= 0) {
+    const LocalRow dDissipation = (2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity;
+    K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta -
+                                            (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
+    Eigen::Map<LocalRow>(ws.nodes[spec_.thermalNode].grad, out.n) = zCoefficient * response.dTheta;
   }
 }
 
@@ -127,13 +131,14 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
   LocalRow rows[3];
   Vec3 separationMid = Vec3::Zero();
   if (geometry_) separationMid = 0.5 * (geometry_->separation(args.zOld) + geometry_->separation(args.zNew));
-  argumentRows(geometry_ ? geometry_->separation(args.zNew) : Vec3::Zero(), rows);
+  argumentRows(geometry_ ? geometry_->separation(args.zNew) : Vec3::Zero(), rows, args.tangent);
   const Response response = respond(alongRows(dEnergy, rows), alongRows(dEntropy, rows));
 
   const Jet entropyNew = entropy(b);
   const double gammaRate = (b[2] - a[2]) / args.dt;
   const double entropyRate = (entropyNew.value - entropy(a).value) / args.dt;
   addBalances(response, 1.0, 2.0 * separationMid, gammaRate, entropyRate, ws, out, flows);
+  if (!args.tangent) return;
 
   // terms from the explicit dependence on zNew: force direction 2 d_mid, gamma' and eta'
   auto K = out.tangent();
@@ -149,7 +154,8 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
 
   LocalRow rows[3];
   const Vec3 separation = geometry_ ? geometry_->separation(args.z) : Vec3::Zero();
-  argumentRows(separation, rows);
+  const bool tangent = args.alpha != 0.0 || args.beta != 0.0;
+  argumentRows(separation, rows, tangent);
   const Response response = respond(alongRows(exactGradient(energy), rows), alongRows(exactGradient(entropy), rows));
   // argument rates: c' = 2 d . d', s', gamma'
   const Vec3 separationRate = geometry_ ? geometry_->separationRate(args.zdot) : Vec3::Zero();
@@ -157,6 +163,7 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
                           localInternal_ >= 0 ? args.zdot[spec_.internalDof] : 0.0);
   const double entropyRate = entropy.grad.dot(argumentRate);
   addBalances(response, args.alpha, 2.0 * separation, argumentRate[2], entropyRate, ws, out, flows);
+  if (!tangent) return;
 
   // explicit dependence on z (force direction, c' through d) and on zdot (the rates)
   auto K = out.tangent();
@@ -178,7 +185,7 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
   path.column = args.column;
   path.start = arguments(args.zOld);
   path.end = arguments(args.zEnd);
-  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows);
+  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows, true);
   for (int j = 0; j < rule.stages; ++j) {
     const double* z = args.stageState[j];
     const double* zdot = args.stageRate[j];
@@ -189,7 +196,7 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
     path.rate[j] =
         args.dt * Vec3(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
                        localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
-    argumentRows(separation, path.rows[j]);
+    argumentRows(separation, path.rows[j], true);
     // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
     // on its own stage's separation as well
     const double rateCoefficient = rule.rate[j][args.column + 1];

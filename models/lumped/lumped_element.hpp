@@ -61,8 +61,9 @@ class LumpedElement final : public Component {
   Vec3 arguments(const double* z) const;
   // From the (discrete) gradients of energy and entropy over (c, s, gamma).
   Response respond(const GradientRows& dEnergy, const GradientRows& dEntropy) const;
-  // Rows over local dofs of d(c, s, gamma)/dz, c's at separation d.
-  void argumentRows(const Vec3& separation, LocalRow (&rows)[3]) const;
+  // Rows over local dofs of d(c, s, gamma)/dz, c's at separation d; empty without a tangent,
+  // so that a residual-only evaluation carries no derivatives (respond, addBalances).
+  void argumentRows(const Vec3& separation, LocalRow (&rows)[3], bool tangent) const;
   static LocalRow chain(const Vec3& dArguments, const LocalRow (&rows)[3]);
   // A discrete gradient's derivative with respect to b, carried onto the local dofs.
   static GradientRows alongRows(const DiscreteGradient& gradient, const LocalRow (&rows)[3]);
