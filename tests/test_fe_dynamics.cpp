@@ -648,7 +648,8 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
 INSTANTIATE_TEST_SUITE_P(Scenes, CondensedNewton,
                          ::testing::Values("lblock_elastic.xml", "lblock_viscoelastic.xml", "tet_bar.xml",
                                            "flexible_pendulum.xml", "double_pendulum.xml", "damped_double_pendulum.xml",
-                                           "thermo_visco_elastic.xml", "lblock_thermoviscoelastic.xml"),
+                                           "thermo_visco_elastic.xml", "two_thermo_springs.xml",
+                                           "lblock_thermoviscoelastic.xml"),
                          [](const ::testing::TestParamInfo<const char*>& info) {
                            const std::string file = info.param;
                            return file.substr(0, file.find('.'));

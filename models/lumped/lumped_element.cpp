@@ -185,7 +185,7 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
   path.column = args.column;
   path.start = arguments(args.zOld);
   path.end = arguments(args.zEnd);
-  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows, true);
+  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows, args.tangent);
   for (int j = 0; j < rule.stages; ++j) {
     const double* z = args.stageState[j];
     const double* zdot = args.stageRate[j];
@@ -196,9 +196,10 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
     path.rate[j] =
         args.dt * Vec3(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
                        localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
-    argumentRows(separation, path.rows[j], true);
+    argumentRows(separation, path.rows[j], args.tangent);
     // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
-    // on its own stage's separation as well
+    // on its own stage's separation as well (rows for a tangent only)
+    if (!args.tangent) continue;
     const double rateCoefficient = rule.rate[j][args.column + 1];
     for (int i = 0; i < 3; ++i) path.rateRows[j][i] = rateCoefficient * path.rows[j][i];
     if (geometry_ && j == args.column) geometry_->addSeparationRow(path.rateRows[j][0], 2.0 * args.dt * separationRate);
@@ -229,6 +230,7 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   const double entropyRate = dEntropy.grad.dot(rate) / args.dt;
   const Vec3 separation = geometry_ ? geometry_->separation(args.stageState[l]) : Vec3::Zero();
   addBalances(response, 1.0, 2.0 * separation, gammaRate, entropyRate, ws, out, flows);
+  if (!args.tangent) return;
 
   // explicit dependence: the force direction 2 d_l on its own stage, gamma' and the entropy rate
   auto K = out.tangent();
