@@ -124,8 +124,9 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
     return gonzalez ? gonzalezGradient(f, mask_, a, b, spec_.argumentScale)
                     : partitionedGradient(f, mask_, a, b, spec_.argumentScale);
   };
+  const Jet entropyNew = entropy(b);
   const DiscreteGradient dEnergy = discreteGradient(energy);
-  const DiscreteGradient dEntropy = linearEntropy_ ? exactGradient(entropy(b)) : discreteGradient(entropy);
+  const DiscreteGradient dEntropy = linearEntropy_ ? exactGradient(entropyNew) : discreteGradient(entropy);
 
   // derivatives of the end-point arguments b with respect to zNew
   LocalRow rows[3];
@@ -134,7 +135,6 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
   argumentRows(geometry_ ? geometry_->separation(args.zNew) : Vec3::Zero(), rows, args.tangent);
   const Response response = respond(alongRows(dEnergy, rows), alongRows(dEntropy, rows));
 
-  const Jet entropyNew = entropy(b);
   const double gammaRate = (b[2] - a[2]) / args.dt;
   const double entropyRate = (entropyNew.value - entropy(a).value) / args.dt;
   addBalances(response, 1.0, 2.0 * separationMid, gammaRate, entropyRate, ws, out, flows);
