@@ -13,6 +13,11 @@ constexpr double kSmallestLineSearchStep = 1.0 / 1024;
 // Simplified Newton keeps a factorisation across step-size changes up to this fraction (the
 // contraction check refreshes it when the old step's tangent no longer contracts well).
 constexpr double kReusableStepChange = 0.2;
+// Newton goes on with the factorisation in hand while its correction is at most this fraction
+// of the increment before it. A fresh factorisation costs several residuals; the iterate the
+// held one reaches lies within this fraction of the increment tolerance of Newton's (3e-13
+// relative), so the balances stay at round-off.
+constexpr double kHeldContraction = 0.003;
 
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
@@ -172,13 +177,15 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     if (iteration == settings_.maxIterations)
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
     // Once the residual passes its test, the factorisation in hand is tried before a fresh
-    // one: a correction it gives within the increment tolerance is the last, applied with a
-    // residual-only evaluation (the converged iterate is as accurate as after a fresh Newton step)
-    bool last = false;
+    // one. A correction within the increment tolerance is the last; one that contracts by
+    // kHeldContraction on the increment before it is applied too, and the next correction comes
+    // from the same factorisation. Either is applied with a residual-only evaluation.
+    bool held = false;
     if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
       solver_.solve(system.residual(), increment_);
-      last = relativeNorm(increment_, zNew) <= settings_.incrementTolerance;
-      refresh = !last;
+      const double heldNorm = relativeNorm(increment_, zNew);
+      held = heldNorm <= settings_.incrementTolerance || heldNorm <= kHeldContraction * incrementNorm;
+      refresh = !held;
     }
     // backtrack along the Newton direction until the residual is finite and decreases (a
     // full step near the solution, where the residual is already at round-off level); if no
@@ -194,15 +201,15 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
       }
       if (refresh && !refactorize(dt, repivot, outcome))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
-      if (!last) solver_.solve(system.residual(), increment_);
-      tangentAtTrial = !simplified && !last && !(iteration == 0 && tangentLikelyDone);
+      if (!held) solver_.solve(system.residual(), increment_);
+      tangentAtTrial = !simplified && !held && !(iteration == 0 && tangentLikelyDone);
       step = lineSearch(zOld, t, dt, zNew, residualNorm, tangentAtTrial);
       if (step > 0.0) break;
       if (refresh && repivot)
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
       repivot = refresh;
       refresh = true;
-      last = false;
+      held = false;
       tangentAtIterate = false;  // the trials replaced the evaluation at zNew
     }
     zNew.swap(trial_);
