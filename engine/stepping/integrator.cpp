@@ -392,7 +392,8 @@ void Integrator::resume(const LoopState& saved) {
   pastTimes_[0] = saved.predictorTime + saved.predictorDt;
   pastCount_ = 2;  // a checkpoint before the first step holds no time: nothing continues it
   predictorDegree_ = 1;
-  motionResolved_ = stageMissKept_ = false;
+  // as a fresh integrator has them: a restart takes the same Newton path as the run it continues
+  motionResolved_ = stageMissKept_ = oneFactorisationSufficed_ = false;
 }
 
 }  // namespace mpx
