@@ -47,9 +47,9 @@ struct NewtonSettings {
   // but the last iterate is less converged than after a fresh Newton step, and the stiff
   // thermal chain's energy balance ends at 1.6e-12 instead of 3e-14 (docs/performance.md).
   double reuseBelowIncrement = 0.0;
-  // Start each step that continues the last one from the linear extrapolation of the previous
-  // two states (eem4: its stages from the last step's stage polynomial, if that step was taken
-  // whole) instead of from the old state.
+  // Start each step that continues the last one from the polynomial through the last two to
+  // four accepted states (eem4: its stages from the same polynomial plus the last step's stage
+  // error) instead of from the old state.
   bool predictor = true;
 };
 
