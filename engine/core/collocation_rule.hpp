@@ -29,6 +29,15 @@ struct CollocationRule {
   std::array<std::array<double, kMostStages>, kFinePoints> fineStage{};
 };
 
+// The Lagrange basis polynomial of point j among points[0..count-1], at x.
+template <std::size_t N>
+double lagrangeBasis(const std::array<double, N>& points, int count, int j, double x) {
+  double value = 1.0;
+  for (int m = 0; m < count; ++m)
+    if (m != j) value *= (x - points[m]) / (points[j] - points[m]);
+  return value;
+}
+
 // The s-stage rule (s = 1, 2: orders 2, 4), from the Lagrange basis on {0, c_1..c_s}.
 inline CollocationRule gaussCollocation(int stages) {
   assert(stages >= 1 && stages <= CollocationRule::kMostStages);
@@ -40,12 +49,7 @@ inline CollocationRule gaussCollocation(int stages) {
   // basis point j: 0 for the step's start, l + 1 for stage l
   std::array<double, CollocationRule::kMostStages + 1> point{};
   for (int l = 0; l < stages; ++l) point[l + 1] = rule.node[l];
-  auto basis = [&](int j, double x) {
-    double value = 1.0;
-    for (int m = 0; m <= stages; ++m)
-      if (m != j) value *= (x - point[m]) / (point[j] - point[m]);
-    return value;
-  };
+  auto basis = [&](int j, double x) { return lagrangeBasis(point, stages + 1, j, x); };
   auto basisSlope = [&](int j, double x) {
     double slope = 0.0;
     for (int skip = 0; skip <= stages; ++skip) {
@@ -57,12 +61,7 @@ inline CollocationRule gaussCollocation(int stages) {
     }
     return slope;
   };
-  auto stageBasis = [&](int l, double x) {
-    double value = 1.0;
-    for (int m = 0; m < stages; ++m)
-      if (m != l) value *= (x - rule.node[m]) / (rule.node[l] - rule.node[m]);
-    return value;
-  };
+  auto stageBasis = [&](int l, double x) { return lagrangeBasis(rule.node, stages, l, x); };
   for (int j = 0; j <= stages; ++j) {
     rule.end[j] = basis(j, 1.0);
     for (int l = 0; l < stages; ++l) rule.rate[l][j] = basisSlope(j, rule.node[l]);

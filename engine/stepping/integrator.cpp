@@ -1,5 +1,7 @@
 #include "engine/stepping/integrator.hpp"
 
+#include "engine/core/collocation_rule.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -248,17 +250,13 @@ bool Integrator::continuesLastStep(const Eigen::VectorXd& z, double t) const {
 }
 
 // The weights of the past states in the polynomial of degree `degree` through the newest
-// degree + 1 of them, at `time` (Lagrange's basis): p(time) = sum_k weight_k z_k. The weights
-// cost O(degree^2) once, so each state entry costs degree + 1 multiply-adds.
+// degree + 1 of them, at `time`: p(time) = sum_k weight_k z_k. The weights cost O(degree^2)
+// once, so each state entry costs degree + 1 multiply-adds.
 namespace {
 template <std::size_t N>
 std::array<double, N> lagrangeWeights(const std::array<double, N>& times, int degree, double time) {
   std::array<double, N> weight{};
-  for (int k = 0; k <= degree; ++k) {
-    weight[k] = 1.0;
-    for (int m = 0; m <= degree; ++m)
-      if (m != k) weight[k] *= (time - times[m]) / (times[k] - times[m]);
-  }
+  for (int k = 0; k <= degree; ++k) weight[k] = lagrangeBasis(times, degree + 1, k, time);
   return weight;
 }
 }  // namespace
