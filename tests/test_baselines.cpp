@@ -98,6 +98,33 @@ TEST(IdaLinearSolver, OwnSparseLuAgreesWithSundialsKlu) {
   EXPECT_LT(sundialsError, 1e-5);
 }
 
+// ida-bdfK caps IDA's BDF order at K: the local error of order K + 1 per step makes the step
+// count grow as rtol^(-1 / (K + 1)), a tenfold for BDF1 over two decades of rtol, 4.6-fold for
+// BDF2, about twofold for the default (up to BDF5). Measured exponents: 0.52, 0.34, 0.16.
+TEST(IdaMaxOrder, StepsGrowWithTheToleranceAsTheCappedOrderImplies) {
+  const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));
+  auto stepExponent = [&](const char* name) {
+    MethodParameters parameters;
+    parameters.tEnd = 20.0;
+    parameters.dt = 1.0;
+    double steps[2];
+    for (int k = 0; k < 2; ++k) {
+      parameters.relativeTolerance = parameters.absoluteTolerance = k == 0 ? 1e-4 : 1e-6;
+      const RunSummary summary = runMethod(*scene.model, *methodByName(name), parameters, [](const StepRecord&) {});
+      EXPECT_FALSE(summary.failed) << summary.failure;
+      steps[k] = summary.ida ? summary.ida->steps : 0;
+    }
+    const double exponent = std::log(steps[1] / steps[0]) / std::log(100.0);
+    std::printf("%s: %g -> %g steps from rtol 1e-4 to 1e-6, exponent %.3f\n", name, steps[0], steps[1], exponent);
+    return exponent;
+  };
+  EXPECT_NEAR(stepExponent("ida-bdf1"), 1.0 / 2, 0.05);
+  EXPECT_NEAR(stepExponent("ida-bdf2"), 1.0 / 3, 0.05);
+  EXPECT_LT(stepExponent("ida"), 0.25);
+  EXPECT_FALSE(methodByName("ida-bdf6"));
+  EXPECT_FALSE(methodByName("ida-bdf"));
+}
+
 // IDA does not keep the energy: its drift at rtol 1e-6 is visible where EEM's is round-off
 TEST(IdaEnergy, DriftsWhereEemDoesNot) {
   const CompiledScene scene = loadScene(scenePath("two_thermo_springs.xml"));

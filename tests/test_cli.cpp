@@ -322,6 +322,8 @@ const std::vector<BadOptions> kBadOptions = {
     {"CompareIntegratorTheSceneRejects", "compare", "--integrators eem,eem-entropy", {"stiffness_curvature"}},
     {"NegativeRelativeTolerance", "run", "--integrator ida --rtol -1e-6", {"--rtol", "positive"}},
     {"MaxOrderSix", "run", "--integrator ida --max-order 6", {"--max-order", "1 to 5"}},
+    {"MaxOrderTwice", "run", "--integrator ida-bdf2 --max-order 3", {"--max-order 3", "'ida-bdf2'", "to 2 already"}},
+    {"BdfOrderSix", "run", "--integrator ida-bdf6", {"unknown integrator 'ida-bdf6'"}},
     {"BenchUnknownIntegrator", "bench", "--integrators eem,rk4", {"unknown integrator 'rk4'"}},
     {"BenchNegativeTolerance", "bench", "--rtols 1e-3,-1e-6", {"--rtols", "-1e-06"}},
     {"BenchZeroStep", "bench", "--dts 0.1,0", {"--dts", "positive"}},

@@ -22,6 +22,11 @@ std::optional<Method> fixedStepMethod(const std::string& name) {
 
 std::optional<Method> methodByName(const std::string& name) {
   if (name == "ida") return Method{name, std::nullopt, std::nullopt};
+  if (name.size() == 8 && name.compare(0, 7, "ida-bdf") == 0 && name[7] >= '1' && name[7] <= '5') {
+    Method ida{name, std::nullopt, std::nullopt};
+    ida.maxOrder = name[7] - '0';
+    return ida;
+  }
   const std::string suffix = "-adaptive";
   const bool adaptive =
       name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -55,8 +60,10 @@ void checkStepCount(double tEnd, double dt, const std::string& where) {
 RunSummary runMethod(const Model& model, const Method& method, const MethodParameters& p, const StepSink& sink,
                      const ProgressSink& progress) {
   if (method.isIda())
-    return simulateIda(model, {p.relativeTolerance, p.absoluteTolerance, p.maxOrder, p.sundialsKlu, p.dt, p.tEnd}, sink,
-                       progress);
+    return simulateIda(model,
+                       {p.relativeTolerance, p.absoluteTolerance, method.maxOrder > 0 ? method.maxOrder : p.maxOrder,
+                        p.sundialsKlu, p.dt, p.tEnd},
+                       sink, progress);
   const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton, p.checkpoints, p.componentFlows};
   if (p.adaptive || method.adaptive)
     return simulateAdaptive(model, options, {p.relativeTolerance, p.absoluteTolerance, p.outputInterval}, sink,

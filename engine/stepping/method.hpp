@@ -17,15 +17,18 @@ struct Method {
   std::optional<Scheme> scheme;                    // the one-step scheme; none for SUNDIALS IDA
   std::optional<ThermalVariable> thermalVariable;  // forced by the method (eem-entropy, ...)
   bool adaptive = false;                           // a one-step scheme with adaptive steps
+  int maxOrder = 0;  // IDA: the largest BDF order the method allows (ida-bdfK); 0: the run's
   bool isIda() const { return !scheme; }
   // Set by a tolerance rather than a step: IDA and the adaptive one-step schemes.
   bool takesTolerance() const { return isIda() || adaptive; }
 };
 
 // The names methodByName accepts, for messages; each one-step name also takes the suffix
-// "-adaptive" (eem-adaptive, eem4-adaptive, ...).
+// "-adaptive" (eem-adaptive, eem4-adaptive, ...), and ida-bdfK is IDA up to BDF order K, so that
+// one bench run can hold IDA at the order that suits a scene next to IDA at its default 5.
 inline constexpr const char* kMethodNames =
-    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, eem4 (each also as NAME-adaptive), ida";
+    "eem, eem-entropy, eem-temperature, midpoint, trapezoidal, eem4 (each also as NAME-adaptive), ida, ida-bdfK "
+    "(BDF order at most K = 1-5)";
 std::optional<Method> methodByName(const std::string& name);
 
 struct MethodParameters {
@@ -36,7 +39,7 @@ struct MethodParameters {
   double relativeTolerance = 1e-6;  // IDA and adaptive steps
   double absoluteTolerance = 1e-6;  // IDA and adaptive steps, times each dof's scale
   double outputInterval = 0.0;      // adaptive steps land on its multiples
-  int maxOrder = 5;                 // IDA
+  int maxOrder = 5;                 // IDA, unless the method sets its own
   bool sundialsKlu = false;         // IDA: SUNDIALS' KLU rather than Metriplex's sparse LU
   Checkpointing checkpoints;        // one-step schemes only (IDA's multistep history cannot be saved)
   bool componentFlows = false;      // one-step schemes: StepRecord::componentCrossed

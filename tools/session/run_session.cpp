@@ -92,6 +92,9 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   CompiledScene scene = request.spec ? compileScene(*request.spec, variable) : loadRequestedScene(request, variable);
   if (!method) method = methodOrThrow(scene.settings.integrator);
   checkMethodSupports(*method, *scene.model, request.scene);
+  if (method->maxOrder > 0 && request.maxOrder != 5 && request.maxOrder != method->maxOrder)
+    throw InputError(fmt::format("option --max-order {}: integrator '{}' sets the order to {} already",
+                                 request.maxOrder, method->name, method->maxOrder));
 
   MethodParameters parameters;
   parameters.dt = request.dt.value_or(scene.settings.dt);
