@@ -24,6 +24,16 @@ constexpr double kHeldContraction = 0.003;
 // balance per step stays at 6e-15; within the tolerance alone it reached 1.3e-14).
 constexpr double kHeldOverTolerance = 0.1;
 
+// After a Newton correction within kRoundOffBand^2 times the increment tolerance (1e-8), the
+// correction from the same factorisation at the next iterate is the last one up to kRoundOffBand
+// times the tolerance: as a correction it leaves an error of the order of the product of the two
+// (1e-17 relative), and as round-off no further correction removes it. eem4's stage gradients
+// divide psi's change over a step by the stage rates, so their residual carries up to 1e-11
+// relative round-off where the arguments barely move (engine/core/stage_gradient.hpp), and
+// corrections there wander at 1e-10-3e-10, around the tolerance: the two thermo-springs from
+// t = 8000 to 16000 took up to 5 iterations and 4 factorisations per step instead of 2 and 1.
+constexpr double kRoundOffBand = 10.0;
+
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
   if (scheme == Scheme::Eem) return Component::LocalForm::Step;
@@ -172,10 +182,14 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   double incrementNorm = INFINITY;
   // whether the factorisation in hand has given a correction beyond the tolerance since it was made
   bool heldOver = false;
+  // whether the factorisation in hand was made at the iterate before the current one, and
+  // whether the correction just applied was taken as the last
+  bool factorisedAtPrevious = false, lastApplied = false;
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
   for (int iteration = 0;; ++iteration) {
     const double incrementTolerance = (heldOver ? kHeldOverTolerance : 1.0) * settings_.incrementTolerance;
-    if (iteration > 0 && incrementNorm <= incrementTolerance && residualNorm <= settings_.residualTolerance) {
+    if (iteration > 0 && (incrementNorm <= incrementTolerance || lastApplied) &&
+        residualNorm <= settings_.residualTolerance) {
       oneFactorisationSufficed_ = outcome.factorizations - factorisationsBefore == 1;
       outcome.energy += system.flows() * dt;
       if (byComponent_)
@@ -185,16 +199,20 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     if (iteration == settings_.maxIterations)
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
     // Once the residual passes its test, the factorisation in hand is tried before a fresh
-    // one. A correction within the increment tolerance is the last; one that contracts by
+    // one. A correction within the increment tolerance is the last (so is one within
+    // kRoundOffBand of it from a factorisation made at the iterate before); one that contracts by
     // kHeldContraction on the increment before it is applied too, and the next correction comes
     // from the same factorisation, which from then on must contract by as much to be kept.
     // Either is applied with a residual-only evaluation.
-    bool held = false;
+    bool held = false, last = false;
     if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
       solver_.solve(system.residual(), increment_);
       const double heldNorm = relativeNorm(increment_, zNew);
-      held = (!heldOver && heldNorm <= settings_.incrementTolerance) || heldNorm <= kHeldContraction * incrementNorm;
-      heldOver = heldOver || (held && heldNorm > settings_.incrementTolerance);
+      last = (!heldOver && heldNorm <= settings_.incrementTolerance) ||
+             (factorisedAtPrevious && heldNorm <= kRoundOffBand * settings_.incrementTolerance &&
+              incrementNorm <= kRoundOffBand * kRoundOffBand * settings_.incrementTolerance);
+      held = last || heldNorm <= kHeldContraction * incrementNorm;
+      heldOver = heldOver || (held && !last);
       refresh = !held;
     }
     // backtrack along the Newton direction until the residual is finite and decreases (a
@@ -220,7 +238,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
         return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
       repivot = refresh;
       refresh = true;
-      held = false;
+      held = last = false;
       tangentAtIterate = false;  // the trials replaced the evaluation at zNew
     }
     zNew.swap(trial_);
@@ -229,6 +247,8 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     const double previousIncrementNorm = incrementNorm;
     incrementNorm = step * relativeNorm(increment_, zNew);
     residualNorm = rescaledNorm(system);
+    factorisedAtPrevious = refresh && !held && step == 1.0;
+    lastApplied = last;
     // keep the factorisation while the iteration contracts well (or has converged); full Newton
     // keeps it too once the increment is small: a tangent taken that close to the solution
     // contracts the next increment about as much as a fresh one (by about its own size)
