@@ -34,6 +34,22 @@ constexpr double kHeldOverTolerance = 0.1;
 // t = 8000 to 16000 took up to 5 iterations and 4 factorisations per step instead of 2 and 1.
 constexpr double kRoundOffBand = 10.0;
 
+// What the correction from the factorisation in hand is worth once the residual passes its test
+// (a fresh factorisation costs several residuals, so it is tried first). A correction within the
+// increment tolerance is the last, and so is one within kRoundOffBand of it from a factorisation
+// made at the iterate before, after a correction within kRoundOffBand^2 of it; one that
+// contracts by kHeldContraction on the increment before it is applied too, and the next
+// correction comes from the same factorisation (held over), which from then on must contract by
+// as much to be kept. Otherwise the factorisation is refreshed.
+enum class HeldCorrection { Refresh, Held, Last };
+HeldCorrection judgeHeldCorrection(double heldNorm, double incrementNorm, double tolerance, bool heldOver,
+                                   bool factorisedAtPrevious) {
+  if ((!heldOver && heldNorm <= tolerance) || (factorisedAtPrevious && heldNorm <= kRoundOffBand * tolerance &&
+                                               incrementNorm <= kRoundOffBand * kRoundOffBand * tolerance))
+    return HeldCorrection::Last;
+  return heldNorm <= kHeldContraction * incrementNorm ? HeldCorrection::Held : HeldCorrection::Refresh;
+}
+
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
   if (scheme == Scheme::Eem) return Component::LocalForm::Step;
@@ -198,21 +214,16 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     }
     if (iteration == settings_.maxIterations)
       return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
-    // Once the residual passes its test, the factorisation in hand is tried before a fresh
-    // one. A correction within the increment tolerance is the last (so is one within
-    // kRoundOffBand of it from a factorisation made at the iterate before); one that contracts by
-    // kHeldContraction on the increment before it is applied too, and the next correction comes
-    // from the same factorisation, which from then on must contract by as much to be kept.
-    // Either is applied with a residual-only evaluation.
+    // once the residual passes its test, the factorisation in hand may give the next correction
+    // (judgeHeldCorrection), which is then applied with a residual-only evaluation
     bool held = false, last = false;
     if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
       solver_.solve(system.residual(), increment_);
-      const double heldNorm = relativeNorm(increment_, zNew);
-      last = (!heldOver && heldNorm <= settings_.incrementTolerance) ||
-             (factorisedAtPrevious && heldNorm <= kRoundOffBand * settings_.incrementTolerance &&
-              incrementNorm <= kRoundOffBand * kRoundOffBand * settings_.incrementTolerance);
-      held = last || heldNorm <= kHeldContraction * incrementNorm;
-      heldOver = heldOver || (held && !last);
+      const HeldCorrection worth = judgeHeldCorrection(relativeNorm(increment_, zNew), incrementNorm,
+                                                       settings_.incrementTolerance, heldOver, factorisedAtPrevious);
+      last = worth == HeldCorrection::Last;
+      held = worth != HeldCorrection::Refresh;
+      heldOver = heldOver || worth == HeldCorrection::Held;
       refresh = !held;
     }
     // backtrack along the Newton direction until the residual is finite and decreases (a
