@@ -198,8 +198,8 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   double incrementNorm = INFINITY;
   // whether the factorisation in hand has given a correction beyond the tolerance since it was made
   bool heldOver = false;
-  // whether the factorisation in hand was made at the iterate before the current one, and
-  // whether the correction just applied was taken as the last
+  // whether the factorisation in hand is of the tangent at the iterate before the current one,
+  // and whether the correction just applied was taken as the last
   bool factorisedAtPrevious = false, lastApplied = false;
   if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
   for (int iteration = 0;; ++iteration) {
@@ -258,7 +258,8 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     const double previousIncrementNorm = incrementNorm;
     incrementNorm = step * relativeNorm(increment_, zNew);
     residualNorm = rescaledNorm(system);
-    factorisedAtPrevious = refresh && !held && step == 1.0;
+    // (a factorisation of the tangent's symmetric part contracts linearly even when fresh)
+    factorisedAtPrevious = refresh && !held && step == 1.0 && !settings_.symmetricFactorisation;
     lastApplied = last;
     // keep the factorisation while the iteration contracts well (or has converged); full Newton
     // keeps it too once the increment is small: a tangent taken that close to the solution
