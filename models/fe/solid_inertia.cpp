@@ -47,17 +47,21 @@ void SolidInertia::measure(const double* z, Measures& out) const {
 }
 
 void SolidInertia::addRows(const NodeVectors& rate, double rateCoefficient, const NodeVectors& kinematics,
-                           double positionCoefficient, double velocityCoefficient, LocalSystem& out) const {
+                           double positionCoefficient, double velocityCoefficient, bool tangent,
+                           LocalSystem& out) const {
   auto r = out.residual();
   auto K = out.tangent();
   const int velocities = 3 * nodes_;
   const NodeVectors momentumRate = rate * mass_ - weight_;
   for (int a = 0; a < nodes_; ++a) {
     r.segment<3>(velocities + 3 * a) = momentumRate.col(a);
+    if (ownsNode_[a]) r.segment<3>(3 * a) = kinematics.col(a);
+  }
+  if (!tangent) return;
+  for (int a = 0; a < nodes_; ++a) {
     for (int b = 0; b < nodes_; ++b)
       K.block<3, 3>(velocities + 3 * a, velocities + 3 * b).diagonal().setConstant(rateCoefficient * mass_(a, b));
     if (!ownsNode_[a]) continue;
-    r.segment<3>(3 * a) = kinematics.col(a);
     K.block<3, 3>(3 * a, 3 * a).diagonal().setConstant(positionCoefficient);
     K.block<3, 3>(3 * a, velocities + 3 * a).diagonal().setConstant(velocityCoefficient);
   }
@@ -66,12 +70,14 @@ void SolidInertia::addRows(const NodeVectors& rate, double rateCoefficient, cons
 void SolidInertia::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&) const {
   const NodeVectors x0 = gather(args.zOld, 0), x1 = gather(args.zNew, 0);
   const NodeVectors v0 = gather(args.zOld, velocityShift_), v1 = gather(args.zNew, velocityShift_);
-  addRows((v1 - v0) / args.dt, 1.0 / args.dt, (x1 - x0) / args.dt - 0.5 * (v0 + v1), 1.0 / args.dt, -0.5, out);
+  addRows((v1 - v0) / args.dt, 1.0 / args.dt, (x1 - x0) / args.dt - 0.5 * (v0 + v1), 1.0 / args.dt, -0.5, args.tangent,
+          out);
 }
 
 void SolidInertia::rateLocal(const RateArgs& args, Workspace&, LocalSystem& out, Flows&) const {
   const NodeVectors v = gather(args.z, velocityShift_);
-  addRows(gather(args.zdot, velocityShift_), args.beta, gather(args.zdot, 0) - v, args.beta, -args.alpha, out);
+  addRows(gather(args.zdot, velocityShift_), args.beta, gather(args.zdot, 0) - v, args.beta, -args.alpha,
+          args.alpha != 0.0 || args.beta != 0.0, out);
 }
 
 }  // namespace mpx

@@ -38,9 +38,10 @@ class SolidInertia final : public Component {
   // Node positions (shift 0) or velocities (shift = velocityShift) of z, one column each.
   NodeVectors gather(const double* z, int shift) const;
   // Momentum rows sum_b M_ab rate_b - f_a, and the kinematic rows from `kinematics` (one
-  // column per node), with their tangent coefficients.
+  // column per node), with their tangent coefficients if `tangent` (a residual-only evaluation
+  // leaves the local tangent unread).
   void addRows(const NodeVectors& rate, double rateCoefficient, const NodeVectors& kinematics,
-               double positionCoefficient, double velocityCoefficient, LocalSystem& out) const;
+               double positionCoefficient, double velocityCoefficient, bool tangent, LocalSystem& out) const;
 
   std::vector<int> firstDofs_;
   int velocityShift_, nodes_;
