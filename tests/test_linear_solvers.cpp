@@ -48,6 +48,11 @@ TEST(DenseFactorisation, SolvesSmallSystemsAndRefusesSingularOnes) {
   const int n = kSmallSystem;
   EXPECT_STREQ(makeSparseLu(n)->name(), "a dense LU");
   EXPECT_STREQ(makeSparseLu(n + 1)->name(), "KLU");
+  // every factorisation but the symmetric part's is of the matrix itself
+  EXPECT_FALSE(makeSparseLu(n)->approximates());
+  EXPECT_FALSE(makeSparseLu(n + 1)->approximates());
+  EXPECT_FALSE(makeSparseLu(kLargeSystem)->approximates());
+  EXPECT_TRUE(makeSparseLu(kLargeSystem, true)->approximates());
   DenseLu solver(n);
   const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
   for (const double diagonal : {0.0, 3.0}) {
@@ -72,6 +77,7 @@ TEST(SymmetricFactorisation, SolvesWithTheSymmetricPart) {
   const Eigen::SparseMatrix<double> a = bandedMatrix(n, 4.0, 0.5);
   const Eigen::VectorXd x = factorizeAndSolve(solver, a, rhs);
   EXPECT_NE(std::string(solver.name()).find("CHOLMOD"), std::string::npos);
+  EXPECT_TRUE(solver.approximates());
   EXPECT_LT((symmetricPartOf(a) * x - rhs).norm(), 1e-12 * rhs.norm());
   // and not with A: the skew part (0.5 off the diagonal) is not negligible
   EXPECT_GT((a * x - rhs).norm(), 1e-2 * rhs.norm());
@@ -89,6 +95,7 @@ TEST(SymmetricFactorisation, FallsBackToTheLuOfTheMatrixWhereTheSymmetricPartIsI
   const Eigen::SparseMatrix<double> a = bandedMatrix(n, 0.5, 0.0);
   EXPECT_LT((a * factorizeAndSolve(solver, a, rhs) - rhs).norm(), 1e-10 * rhs.norm());
   EXPECT_NE(std::string(solver.name()).find("UMFPACK"), std::string::npos);
+  EXPECT_FALSE(solver.approximates());
   // and stays with the LU for later matrices, also positive definite ones
   const Eigen::SparseMatrix<double> b = bandedMatrix(n, 4.0, 0.5);
   EXPECT_LT((b * factorizeAndSolve(solver, b, rhs) - rhs).norm(), 1e-12 * rhs.norm());
@@ -102,8 +109,10 @@ TEST(SymmetricFactorisation, CondensedSolverReportsTheLuThatTookOver) {
   const Eigen::SparseMatrix<double> a = bandedMatrix(n, 0.5, 0.0);
   CondensedSolver solver(Layout({0, 0, n, 0, 0}), a, true);
   EXPECT_NE(solver.describe().find("CHOLMOD"), std::string::npos) << solver.describe();
+  EXPECT_FALSE(solver.factorisesTheTangent());
   ASSERT_TRUE(solver.factorize(a, false));
   EXPECT_NE(solver.describe().find("UMFPACK"), std::string::npos) << solver.describe();
+  EXPECT_TRUE(solver.factorisesTheTangent());
   const Eigen::VectorXd residual = Eigen::VectorXd::Ones(n);
   Eigen::VectorXd increment(n);
   solver.solve(residual, increment);

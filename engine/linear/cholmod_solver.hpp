@@ -23,6 +23,7 @@ class CholmodSolver final : public SparseLu {
   bool factorize(const Eigen::SparseMatrix<double>& matrix, bool repivot) override;
   void solve(Eigen::VectorXd& rhs) override;
   const char* name() const override;
+  bool approximates() const override { return !notPositiveDefinite_; }
 
  private:
   // The upper triangle of the symmetric part's pattern, and where each entry of the matrix

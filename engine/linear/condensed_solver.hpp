@@ -42,6 +42,8 @@ class CondensedSolver {
   void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_, denseUpTo_); }
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
+  // Whether the last factorisation is of the (condensed) tangent itself, not an approximation.
+  bool factorisesTheTangent() const { return !lu_->approximates(); }
   // Unknowns of the system actually factorised.
   int condensedSize() const { return static_cast<int>(factorised().rows()); }
   // Why the velocities could not be eliminated ("" when they are, or when there are none).

@@ -17,6 +17,9 @@ class SparseLu {
   virtual void solve(Eigen::VectorXd& rhs) = 0;
   // The factorisation's name for run summaries ("KLU", ...).
   virtual const char* name() const = 0;
+  // True where what is factorised approximates the matrix (its symmetric part): Newton then
+  // contracts linearly even with a fresh factorisation.
+  virtual bool approximates() const { return false; }
 };
 
 // Systems of at least this many unknowns go to UMFPACK. Of at most kSmallSystem to a dense LU;

@@ -259,7 +259,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     incrementNorm = step * relativeNorm(increment_, zNew);
     residualNorm = rescaledNorm(system);
     // (a factorisation of the tangent's symmetric part contracts linearly even when fresh)
-    factorisedAtPrevious = refresh && !held && step == 1.0 && !settings_.symmetricFactorisation;
+    factorisedAtPrevious = refresh && !held && step == 1.0 && solver_.factorisesTheTangent();
     lastApplied = last;
     // keep the factorisation while the iteration contracts well (or has converged); full Newton
     // keeps it too once the increment is small: a tangent taken that close to the solution
