@@ -127,7 +127,7 @@ AttributeValue attributeOf(const std::string& name, const py::handle& value) {
 
 py::object run(const py::object& scene, const std::string& integrator, std::optional<double> dt,
                std::optional<double> tEnd, const std::string& out, std::optional<double> outputInterval, bool adaptive,
-               std::optional<double> rtol, std::optional<double> atol, int maxOrder, bool sundialsKlu,
+               std::optional<double> rtol, std::optional<double> atol, std::optional<int> maxOrder, bool sundialsKlu,
                std::optional<double> dtOut, int checkpointEvery, const std::string& restart, bool budget,
                bool urdfLimits) {
   RunRequest request;
@@ -224,7 +224,7 @@ PYBIND11_MODULE(_metriplex, module) {
   module.def("run", &run, py::arg("scene"), py::kw_only(), py::arg("integrator") = "", py::arg("dt") = py::none(),
              py::arg("t_end") = py::none(), py::arg("out") = "", py::arg("output_interval") = py::none(),
              py::arg("adaptive") = false, py::arg("rtol") = py::none(), py::arg("atol") = py::none(),
-             py::arg("max_order") = 5, py::arg("sundials_klu") = false, py::arg("dt_out") = py::none(),
+             py::arg("max_order") = py::none(), py::arg("sundials_klu") = false, py::arg("dt_out") = py::none(),
              py::arg("checkpoint_every") = 0, py::arg("restart") = "", py::arg("budget") = false,
              py::arg("urdf_limits") = false,
              "Run a scene file (str or path) or a Scene with the options of `metriplex run` (docs/python.md). "

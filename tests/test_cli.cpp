@@ -323,6 +323,7 @@ const std::vector<BadOptions> kBadOptions = {
     {"NegativeRelativeTolerance", "run", "--integrator ida --rtol -1e-6", {"--rtol", "positive"}},
     {"MaxOrderSix", "run", "--integrator ida --max-order 6", {"--max-order", "1 to 5"}},
     {"MaxOrderTwice", "run", "--integrator ida-bdf2 --max-order 3", {"--max-order 3", "'ida-bdf2'", "to 2 already"}},
+    {"MaxOrderFiveTwice", "run", "--integrator ida-bdf2 --max-order 5", {"--max-order 5", "to 2 already"}},
     {"BdfOrderSix", "run", "--integrator ida-bdf6", {"unknown integrator 'ida-bdf6'"}},
     {"BenchUnknownIntegrator", "bench", "--integrators eem,rk4", {"unknown integrator 'rk4'"}},
     {"BenchNegativeTolerance", "bench", "--rtols 1e-3,-1e-6", {"--rtols", "-1e-06"}},

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", request.out, "output directory (default: out/<scene name>-<integrator>)");
   addToleranceOptions(run, request);
   addUrdfLimitsOption(run, request);
-  run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5)")->capture_default_str();
+  run->add_option("--max-order", request.maxOrder, "ida: maximum BDF order (1-5; default: 5, or K for ida-bdfK)");
   run->add_flag("--sundials-klu", request.sundialsKlu,
                 "ida: factorise the whole Newton matrix with SUNDIALS' KLU instead of Metriplex's solver (velocities "
                 "eliminated, then a dense LU, KLU or UMFPACK by size)");

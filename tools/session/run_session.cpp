@@ -84,17 +84,17 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   checkPositive(request.relativeTolerance, "--rtol");
   checkPositive(request.absoluteTolerance, "--atol");
   checkPositive(request.outputStep, "--dt-out");
-  if (request.maxOrder < 1 || request.maxOrder > 5)
-    throw InputError(fmt::format("option --max-order must be 1 to 5, got {}", request.maxOrder));
+  if (request.maxOrder && (*request.maxOrder < 1 || *request.maxOrder > 5))
+    throw InputError(fmt::format("option --max-order must be 1 to 5, got {}", *request.maxOrder));
   std::optional<Method> method;
   if (!request.integrator.empty()) method = methodOrThrow(request.integrator);
   const std::optional<ThermalVariable> variable = method ? method->thermalVariable : std::nullopt;
   CompiledScene scene = request.spec ? compileScene(*request.spec, variable) : loadRequestedScene(request, variable);
   if (!method) method = methodOrThrow(scene.settings.integrator);
   checkMethodSupports(*method, *scene.model, request.scene);
-  if (method->maxOrder > 0 && request.maxOrder != 5 && request.maxOrder != method->maxOrder)
+  if (method->maxOrder > 0 && request.maxOrder && *request.maxOrder != method->maxOrder)
     throw InputError(fmt::format("option --max-order {}: integrator '{}' sets the order to {} already",
-                                 request.maxOrder, method->name, method->maxOrder));
+                                 *request.maxOrder, method->name, method->maxOrder));
 
   MethodParameters parameters;
   parameters.dt = request.dt.value_or(scene.settings.dt);
@@ -106,7 +106,7 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   parameters.absoluteTolerance = request.absoluteTolerance.value_or(
       request.relativeTolerance || sceneAtol == 0.0 ? parameters.relativeTolerance : sceneAtol);
   parameters.outputInterval = request.frameInterval.value_or(0.0);
-  parameters.maxOrder = request.maxOrder;
+  parameters.maxOrder = request.maxOrder.value_or(parameters.maxOrder);
   parameters.sundialsKlu = request.sundialsKlu;
   if (method->isIda()) parameters.dt = request.outputStep.value_or(parameters.dt);
   checkStepCount(parameters.tEnd, parameters.dt,

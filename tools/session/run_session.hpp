@@ -23,7 +23,7 @@ struct RunRequest {
   // IDA and adaptive steps; empty: the scene's
   std::optional<double> relativeTolerance, absoluteTolerance;
   // IDA only
-  int maxOrder = 5;
+  std::optional<int> maxOrder;  // empty: the method's (ida-bdfK), else 5
   bool sundialsKlu = false;
   std::optional<double> outputStep;
   // one-step schemes
