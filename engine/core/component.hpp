@@ -144,6 +144,14 @@ class Component {
 
   // Add energy, entropy, momenta and node temperatures of state z.
   virtual void measure(const double* z, Measures& out) const = 0;
+  // The spatial 3-vectors among the dofs a component owns (global index of the first position
+  // and first velocity entry of each), each a point or a free vector (a director): simplified
+  // Newton turns its kept factorisation with them (engine/linear/corotation.hpp).
+  struct SpatialVector {
+    int position, velocity;
+    bool point;
+  };
+  virtual void spatialVectors(std::vector<SpatialVector>& /*out*/) const {}
   // EEM step residual (rate form, ~ F(t + dt/2, z_mid, (zNew - zOld)/dt)) and its derivative
   // with respect to zNew.
   virtual void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const = 0;

@@ -130,7 +130,7 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   } else if (options.sundialsKlu) {
     linearSolver_ = SUNLinSol_KLU(y_, jacobian_, context_);
   } else {
-    linearSolver_ = makeIdaLinearSolver(model.layout(), assembler_.tangent(), context_);
+    linearSolver_ = makeIdaLinearSolver(model, assembler_.tangent(), ida_, options.corotate, context_);
   }
   linearSystem_ = dense_ || options.sundialsKlu ? std::to_string(n) + " unknowns factorised by " +
                                                       (dense_ ? "dense LU (SUNDIALS)" : "KLU (SUNDIALS)")

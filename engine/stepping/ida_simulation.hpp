@@ -19,6 +19,9 @@ struct IdaOptions {
   // LU (KLU, UMFPACK from kLargeSystem unknowns: engine/linear/sparse_lu.hpp), or with this
   // set to SUNDIALS' own KLU.
   bool sundialsKlu = false;
+  // Metriplex's sparse LU: each correction turns the Newton matrix with the scene since it was
+  // set up (engine/linear/corotation.hpp)
+  bool corotate = true;
   double outputStep = 0.0;  // history rows at multiples of this
   double tEnd = 0.0;
 };

@@ -64,6 +64,8 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       rule_(gaussCollocation(scheme == Scheme::Eem4 ? 2 : 1)),
       assembler_(model, localForm(scheme), rule_.stages),
       solver_(model.layout(), assembler_.tangent(), settings.symmetricFactorisation && rule_.stages == 1),
+      corotation_(model, rule_.stages),
+      turnedResidual_(rule_.stages * model.layout().total()),
       workspace_(model.makeWorkspace()),
       zMid_(model.layout().total()),
       zDot_(model.layout().total()),
@@ -178,6 +180,8 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
   const bool tangentLikelyDone = oneFactorisationSufficed_;
   const int factorisationsBefore = outcome.factorizations;
   bool refresh = !simplified || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
+  // a factorisation kept from an earlier step turns with the scene to this step's start
+  if (!refresh && settings_.corotate) corotation_.follow(zOld);
   bool tangentAtIterate = refresh;
   // the residual norm relative to row scales taken from the tangent at the current iterate
   // (after a residual-only evaluation, from the last tangent evaluated)
@@ -218,7 +222,7 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
     // (judgeHeldCorrection), which is then applied with a residual-only evaluation
     bool held = false, last = false;
     if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
-      solver_.solve(system.residual(), increment_);
+      correct(system.residual());
       const HeldCorrection worth = judgeHeldCorrection(relativeNorm(increment_, zNew), incrementNorm,
                                                        settings_.incrementTolerance, heldOver, factorisedAtPrevious);
       last = worth == HeldCorrection::Last;
@@ -238,10 +242,10 @@ bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt,
         evaluate(zOld, zNew, t, dt);
         residualNorm = rescaledNorm(system);
       }
-      if (refresh && !refactorize(dt, repivot, outcome))
+      if (refresh && !refactorize(zOld, dt, repivot, outcome))
         return fail("singular tangent", iteration, incrementNorm, residualNorm);
       heldOver = heldOver && !refresh;
-      if (!held) solver_.solve(system.residual(), increment_);
+      if (!held) correct(system.residual());
       tangentAtTrial = !simplified && !held && !(iteration == 0 && tangentLikelyDone);
       step = lineSearch(zOld, t, dt, zNew, residualNorm, tangentAtTrial);
       if (step > 0.0) break;
@@ -325,12 +329,24 @@ void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reach
     if (miss[k] < miss[predictorDegree_]) predictorDegree_ = k;
 }
 
-bool Integrator::refactorize(double dt, bool repivot, StepOutcome& outcome) {
+bool Integrator::refactorize(const Eigen::VectorXd& zOld, double dt, bool repivot, StepOutcome& outcome) {
   factorizedDt_ = 0.0;
   ++outcome.factorizations;
   if (!solver_.factorize(assembler_.tangent(), repivot)) return false;
   factorizedDt_ = dt;
+  corotation_.anchor(zOld);
   return true;
+}
+
+void Integrator::correct(const Eigen::VectorXd& residual) {
+  if (!corotation_.turned()) {
+    solver_.solve(residual, increment_);
+    return;
+  }
+  turnedResidual_ = residual;
+  corotation_.toAnchor(turnedResidual_);
+  solver_.solve(turnedResidual_, increment_);
+  corotation_.fromAnchor(increment_);
 }
 
 double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,

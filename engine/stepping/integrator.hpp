@@ -6,6 +6,7 @@
 #include "engine/core/model.hpp"
 #include "engine/linear/assembler.hpp"
 #include "engine/linear/condensed_solver.hpp"
+#include "engine/linear/corotation.hpp"
 #include "engine/stepping/loop_state.hpp"
 
 #include <Eigen/Dense>
@@ -47,6 +48,9 @@ struct NewtonSettings {
   // but the last iterate is less converged than after a fresh Newton step, and the stiff
   // thermal chain's energy balance ends at 1.6e-12 instead of 3e-14 (docs/performance.md).
   double reuseBelowIncrement = 0.0;
+  // Simplified Newton turns a factorisation kept from an earlier step with the scene's rotation
+  // since then (engine/linear/corotation.hpp).
+  bool corotate = true;
   // Start each step that continues the last one from the polynomial through the last two to
   // four accepted states (eem4: its stages from the same polynomial plus the last step's stage
   // error) instead of from the old state.
@@ -111,8 +115,12 @@ class Integrator {
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
   // z(t + dt) of the stage polynomial.
   void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
-  // Factorise the tangent of the last evaluation that assembled one; false if singular.
-  bool refactorize(double dt, bool repivot, StepOutcome& outcome);
+  // Factorise the tangent of the last evaluation that assembled one, for the step from zOld;
+  // false if singular.
+  bool refactorize(const Eigen::VectorXd& zOld, double dt, bool repivot, StepOutcome& outcome);
+  // increment_ = the Newton correction for `residual` from the factorisation in hand, turned
+  // with the scene since it was made.
+  void correct(const Eigen::VectorXd& residual);
   // max_i |increment_i| / (|z_i| + scale_i), the increment test's norm (multipliers left out)
   double relativeNorm(const Eigen::VectorXd& increment, const Eigen::VectorXd& z) const;
   // Largest step 1, 1/2, ... along increment_ from zNew that decreases the residual (left
@@ -126,6 +134,8 @@ class Integrator {
   CollocationRule rule_;  // eem4's; one stage otherwise
   Assembler assembler_;
   CondensedSolver solver_;
+  Corotation corotation_;
+  Eigen::VectorXd turnedResidual_;
   Workspace workspace_;
   Eigen::VectorXd zMid_, zDot_, increment_, trial_, stateScale_;
   // per Newton unknown: its dof's scale, and the same with multipliers at infinity (multipliers

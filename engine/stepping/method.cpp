@@ -62,7 +62,7 @@ RunSummary runMethod(const Model& model, const Method& method, const MethodParam
   if (method.isIda())
     return simulateIda(model,
                        {p.relativeTolerance, p.absoluteTolerance, method.maxOrder > 0 ? method.maxOrder : p.maxOrder,
-                        p.sundialsKlu, p.dt, p.tEnd},
+                        p.sundialsKlu, p.newton.corotate, p.dt, p.tEnd},
                        sink, progress);
   const RunOptions options{*method.scheme, p.dt, p.tEnd, p.newton, p.checkpoints, p.componentFlows};
   if (p.adaptive || method.adaptive)

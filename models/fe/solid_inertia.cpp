@@ -23,6 +23,11 @@ SolidInertia::SolidInertia(const SolidInertiaSpec& spec)
   weight_ = spec.gravity * mass_.rowwise().sum().transpose();
 }
 
+void SolidInertia::spatialVectors(std::vector<SpatialVector>& out) const {
+  for (int a = 0; a < nodes_; ++a)
+    if (ownsNode_[a]) out.push_back({firstDofs_[a], firstDofs_[a] + velocityShift_, true});
+}
+
 bool SolidInertia::couples(int row, int column, LocalForm) const {
   const int velocities = 3 * nodes_;
   if (row < velocities) return ownsNode_[row / 3] && (column == row || column == row + velocities);

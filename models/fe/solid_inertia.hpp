@@ -28,6 +28,8 @@ class SolidInertia final : public Component {
 
   bool couples(int row, int column, LocalForm) const override;
   void measure(const double* z, Measures& out) const override;
+  // the nodes the cell owns, as points
+  void spatialVectors(std::vector<SpatialVector>& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   // eem4: a kinetic energy quadratic in the velocities and a constant weight

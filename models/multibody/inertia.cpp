@@ -20,6 +20,12 @@ Inertia::Inertia(std::string name, int firstPositionDof, int firstVelocityDof, s
       blocks_(std::move(blocks)),
       gravity_(gravity) {}
 
+void Inertia::spatialVectors(std::vector<SpatialVector>& out) const {
+  for (std::size_t b = 0; b < blocks_.size(); ++b)
+    out.push_back({firstPositionDof_ + 3 * static_cast<int>(b), firstVelocityDof_ + 3 * static_cast<int>(b),
+                   blocks_[b].translational});
+}
+
 void Inertia::measure(const double* z, Measures& out) const {
   for (std::size_t b = 0; b < blocks_.size(); ++b) {
     const Vec3 x = vec3At(z, firstPositionDof_ + 3 * b), v = vec3At(z, firstVelocityDof_ + 3 * b);

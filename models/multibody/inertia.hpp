@@ -25,6 +25,8 @@ class Inertia final : public Component {
     return column == row || (row < velocityRows && column == row + velocityRows);
   }
   void measure(const double* z, Measures& out) const override;
+  // translational blocks are points, director blocks free vectors
+  void spatialVectors(std::vector<SpatialVector>& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   // eem4: a kinetic energy quadratic in the velocities and a constant weight

@@ -61,6 +61,7 @@ void readSolver(ElementReader& in, NewtonSettings& n) {
   n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
   n.reuseBelowIncrement = in.nonNegative("reuse_below_increment", n.reuseBelowIncrement);
   n.symmetricFactorisation = in.flag("symmetric_factorisation", n.symmetricFactorisation);
+  n.corotate = in.flag("corotate", n.corotate);
   if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
   if (!(n.reuseContraction < 1.0)) in.fail("reuse_contraction must be below 1 (0: full Newton)");
   if (n.symmetricFactorisation && n.reuseContraction == 0.0)
