@@ -144,12 +144,15 @@ class Component {
 
   // Add energy, entropy, momenta and node temperatures of state z.
   virtual void measure(const double* z, Measures& out) const = 0;
-  // The spatial 3-vectors among the dofs a component owns (global index of the first position
-  // and first velocity entry of each), each a point or a free vector (a director): simplified
-  // Newton turns its kept factorisation with them (engine/linear/corotation.hpp).
+  // The spatial 3-vectors among the dofs a component owns: the global index of the first of
+  // three consecutive entries, and of the vector paired with it (a position's velocity, a
+  // constraint multiplier's GGL multiplier mu). Points and directions (directors) of the
+  // configuration fix the rotation a kept factorisation is turned by; forces (multipliers) are
+  // only turned with it (engine/linear/corotation.hpp).
   struct SpatialVector {
-    int position, velocity;
-    bool point;
+    enum class Kind { Point, Direction, Force };
+    int first, paired;
+    Kind kind;
   };
   virtual void spatialVectors(std::vector<SpatialVector>& /*out*/) const {}
   // EEM step residual (rate form, ~ F(t + dt/2, z_mid, (zNew - zOld)/dt)) and its derivative

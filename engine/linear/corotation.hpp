@@ -1,15 +1,15 @@
 #pragma once
 // A factorisation kept across steps (simplified Newton) turned with the scene. Where the model
 // is invariant under rotations, its tangent follows the configuration as K(Q z) = Q K(z) Q^T,
-// with Q turning every spatial 3-vector of the state (point and director positions, their
-// velocities) by one rotation R. A factorisation made at configuration z_f then serves a
-// configuration z close to Q z_f as
+// with Q turning every spatial 3-vector of the state (points and directors, their velocities,
+// the multipliers of constraints that make two points coincide) by one rotation R. A factorisation made at
+// configuration z_f then serves a configuration z close to Q z_f as
 //   dz = -Q K(z_f)^{-1} Q^T r,
-// with R the rotation that best carries z_f's spatial vectors onto z's (least squares, points
-// about their centroid). A scene that turns as a whole (the flyball governor spins at 2 pi rad/s)
+// with R the rotation that best carries z_f's points and directions onto z's (least squares,
+// points about their centroid). A scene that turns as a whole (the flyball governor spins at 2 pi rad/s)
 // keeps one factorisation for many steps this way, where the factorisation taken as it was
-// stops contracting within a few degrees. Scalars, internal variables and multipliers are left
-// as they are; where the model is not invariant, or R fits badly, the correction is simply
+// stops contracting within a few degrees. Scalars, internal variables and the multipliers of
+// scalar constraints are left as they are; where the model is not invariant, or R fits badly, the correction is simply
 // worse and Newton, judged on the true residual, refreshes the factorisation as before.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
@@ -27,7 +27,7 @@ class Corotation {
 
   // The configuration the factorisation is made at: no rotation from here.
   void anchor(const Eigen::VectorXd& z);
-  // The rotation that best carries the anchor's spatial vectors onto z's.
+  // The rotation that best carries the anchor's points and directions onto z's.
   void follow(const Eigen::VectorXd& z);
   // Whether follow found a rotation other than the identity.
   bool turned() const { return turned_; }
@@ -38,10 +38,13 @@ class Corotation {
 
  private:
   void turn(Eigen::VectorXd& v, const Eigen::Matrix3d& rotation) const;
+  bool isPoint(int k) const { return vectors_[k].kind == Component::SpatialVector::Kind::Point; }
 
+  // the configuration's vectors (points and directions) first, configuration_ of them
   std::vector<Component::SpatialVector> vectors_;
+  int configuration_ = 0;
   int stateSize_, stages_;
-  std::vector<Eigen::Vector3d> anchored_;  // per spatial vector, its position at the anchor
+  std::vector<Eigen::Vector3d> anchored_;  // per configuration vector, its value at the anchor
   Eigen::Vector3d anchoredCentroid_ = Eigen::Vector3d::Zero();
   int points_ = 0;
   Eigen::Matrix3d rotation_ = Eigen::Matrix3d::Identity();

@@ -25,7 +25,7 @@ SolidInertia::SolidInertia(const SolidInertiaSpec& spec)
 
 void SolidInertia::spatialVectors(std::vector<SpatialVector>& out) const {
   for (int a = 0; a < nodes_; ++a)
-    if (ownsNode_[a]) out.push_back({firstDofs_[a], firstDofs_[a] + velocityShift_, true});
+    if (ownsNode_[a]) out.push_back({firstDofs_[a], firstDofs_[a] + velocityShift_, SpatialVector::Kind::Point});
 }
 
 bool SolidInertia::couples(int row, int column, LocalForm) const {

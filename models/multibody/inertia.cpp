@@ -23,7 +23,7 @@ Inertia::Inertia(std::string name, int firstPositionDof, int firstVelocityDof, s
 void Inertia::spatialVectors(std::vector<SpatialVector>& out) const {
   for (std::size_t b = 0; b < blocks_.size(); ++b)
     out.push_back({firstPositionDof_ + 3 * static_cast<int>(b), firstVelocityDof_ + 3 * static_cast<int>(b),
-                   blocks_[b].translational});
+                   blocks_[b].translational ? SpatialVector::Kind::Point : SpatialVector::Kind::Direction});
 }
 
 void Inertia::measure(const double* z, Measures& out) const {

@@ -25,7 +25,7 @@ class Inertia final : public Component {
     return column == row || (row < velocityRows && column == row + velocityRows);
   }
   void measure(const double* z, Measures& out) const override;
-  // translational blocks are points, director blocks free vectors
+  // translational blocks are points, director blocks directions
   void spatialVectors(std::vector<SpatialVector>& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

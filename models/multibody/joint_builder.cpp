@@ -51,6 +51,11 @@ int constraintCount(JointType type) {
   return 0;
 }
 
+bool coincidesPoints(JointType type) {
+  return type == JointType::Spherical || type == JointType::Revolute || type == JointType::Universal ||
+         type == JointType::Fixed;
+}
+
 JointBuilder::JointBuilder(const Attachment& a, const Attachment& b)
     : sides_{a, b}, ends_{a.firstPositionDof, b.firstPositionDof} {
   offset_[1] = dofCount(a);

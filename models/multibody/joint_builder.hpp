@@ -36,6 +36,9 @@ inline constexpr const char* kJointTypeNames =
     "spherical, revolute, universal, cylindrical, prismatic, fixed, distance, planar";
 std::optional<JointType> jointTypeByName(const std::string& name);
 int constraintCount(JointType type);
+// Whether the first three forms of JointBuilder::joint(type, ...) are the x, y and z components
+// of the gap between the two anchor points: one spatial vector, and so are their multipliers.
+bool coincidesPoints(JointType type);
 
 struct JointGeometry {
   Vec3 anchor = Vec3::Zero();   // joint point (world, t = 0); on b for a distance joint: anchorB

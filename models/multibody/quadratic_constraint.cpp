@@ -30,6 +30,12 @@ double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
   return augmented() ? z[spec_.firstMultiplierDof + k] : 0.0;
 }
 
+void QuadraticConstraint::spatialVectors(std::vector<SpatialVector>& out) const {
+  if (augmented() && spec_.leadingGap)
+    out.push_back({spec_.firstMultiplierDof, spec_.firstMultiplierDof + static_cast<int>(spec_.forms.size()),
+                   SpatialVector::Kind::Force});
+}
+
 void QuadraticConstraint::measure(const double* z, Measures& out) const {
   const ConstraintVector q = gather(z, 0);
   for (std::size_t k = 0; k < spec_.forms.size(); ++k) {

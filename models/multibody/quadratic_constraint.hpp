@@ -30,7 +30,8 @@ struct ConstraintSpec {
   std::vector<QuadraticForm> forms;
   Enforcement enforcement = Enforcement::Penalty;
   double stiffness = 0.0;
-  int firstMultiplierDof = -1;  // augmented Lagrangian: lambda_k then mu_k, two per form
+  int firstMultiplierDof = -1;  // augmented Lagrangian: lambda_0 ... lambda_m-1, then mu_0 ... mu_m-1
+  bool leadingGap = false;      // forms 0-2 are the components of the gap between two points
 };
 
 class QuadraticConstraint final : public Component {
@@ -53,6 +54,8 @@ class QuadraticConstraint final : public Component {
   bool multipliersHeldAtZero(std::size_t k) const { return implied_[k]; }
 
   void measure(const double* z, Measures& out) const override;
+  // augmented Lagrangian with a leading gap: its lambdas and mus are forces
+  void spatialVectors(std::vector<SpatialVector>& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   StageForm stageForm() const override { return StageForm::Own; }

@@ -68,7 +68,7 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
       name, phi, phiRate, std::vector<InertiaBlock>{{mass, true}, {E[0], false}, {E[1], false}, {E[2], false}},
       build.spec.gravity));
   const JointBuilder builder(build.attachments[name]);
-  build.addConstraint(name + ".rigidity", builder, builder.rigidity(), rigidity, dofs);
+  build.addConstraint(name + ".rigidity", builder, builder.rigidity(), false, rigidity, dofs);
 }
 
 DofDemand declareJoint(ElementReader& in, SceneBuild& build) {
@@ -104,7 +104,7 @@ void buildJoint(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   const ConstraintSettings settings = build.constraintSettings(in);
   const JointBuilder builder(a, b);
   try {
-    build.addConstraint(name, builder, builder.joint(*type, geometry), settings, dofs);
+    build.addConstraint(name, builder, builder.joint(*type, geometry), coincidesPoints(*type), settings, dofs);
   } catch (const std::invalid_argument& e) {
     in.fail(e.what());
   }

@@ -150,9 +150,10 @@ bool SceneBuild::takesMultipliers(const ElementReader& in) const {
 }
 
 void SceneBuild::addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
-                               const ConstraintSettings& settings, DofRange& dofs) {
+                               bool leadingGap, const ConstraintSettings& settings, DofRange& dofs) {
   ConstraintSpec constraint;
   constraint.name = name;
+  constraint.leadingGap = leadingGap;
   constraint.positionDofs = builder.positionDofs();
   constraint.velocityShift = velocityShift();
   constraint.enforcement = settings.enforcement;

@@ -141,9 +141,10 @@ class SceneBuild {
   ConstraintSettings constraintSettings(ElementReader& in) const;
   // Whether an element's constraints take multipliers (declare pass: no validation).
   bool takesMultipliers(const ElementReader& in) const;
-  // Penalty or augmented-Lagrangian enforcement of `forms`, with multipliers when needed.
+  // Penalty or augmented-Lagrangian enforcement of `forms`, with multipliers when needed;
+  // `leadingGap`: forms 0-2 are the components of the gap between two points (coincidesPoints).
   void addConstraint(const std::string& name, const JointBuilder& builder, std::vector<QuadraticForm> forms,
-                     const ConstraintSettings& settings, DofRange& dofs);
+                     bool leadingGap, const ConstraintSettings& settings, DofRange& dofs);
 
   // The solid named by attribute 'solid', and the sorted nodes of its set named by 'surface'.
   const SolidPlacement& solidOf(ElementReader& in) const;

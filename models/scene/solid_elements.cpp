@@ -298,7 +298,7 @@ void buildSolidJoint(ElementReader& in, SceneBuild& build, DofRange& dofs) {
     JointGeometry geometry;
     geometry.anchor = point.position;
     build.addConstraint(name + ".node" + std::to_string(node), builder, builder.joint(JointType::Spherical, geometry),
-                        settings, dofs);
+                        coincidesPoints(JointType::Spherical), settings, dofs);
   }
 }
 
