@@ -8,9 +8,7 @@
 #include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_dense.h>
 #include <sunlinsol/sunlinsol_klu.h>
-#include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <cmath>
@@ -21,8 +19,6 @@ namespace mpx {
 
 namespace {
 
-// Models up to this many unknowns use a dense Jacobian; larger ones a sparse one.
-constexpr int kLargestDenseSystem = 64;
 // The energies crossing the boundary, integrated as IDA quadratures (outside the Newton system
 // and the error test): dissipated, external work, boundary heat, boundary entropy.
 constexpr int kQuadratures = 4;
@@ -73,7 +69,6 @@ class IdaProblem {
   Workspace workspace_;
   int modelSize_;
   double relativeTolerance_;
-  bool dense_;
   SUNContext context_ = nullptr;
   N_Vector y_ = nullptr, yp_ = nullptr, id_ = nullptr, atol_ = nullptr, crossed_ = nullptr;
   SUNMatrix jacobian_ = nullptr;
@@ -88,8 +83,7 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
       assembler_(model, Component::LocalForm::Rate),
       workspace_(model.makeWorkspace()),
       modelSize_(model.layout().total()),
-      relativeTolerance_(options.relativeTolerance),
-      dense_(model.layout().total() <= kLargestDenseSystem) {
+      relativeTolerance_(options.relativeTolerance) {
   const int n = modelSize_;
   check(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
   y_ = N_VNew_Serial(n, context_);
@@ -124,17 +118,14 @@ IdaProblem::IdaProblem(const Model& model, const IdaOptions& options)
   check(IDAQuadInit(ida_, flows, crossed_), "IDAQuadInit");
 
   const auto nonZeros = static_cast<sunindextype>(assembler_.tangent().nonZeros());
-  jacobian_ = dense_ ? SUNDenseMatrix(n, n, context_) : SUNSparseMatrix(n, n, nonZeros, CSC_MAT, context_);
-  if (dense_) {
-    linearSolver_ = SUNLinSol_Dense(y_, jacobian_, context_);
-  } else if (options.sundialsKlu) {
+  jacobian_ = SUNSparseMatrix(n, n, nonZeros, CSC_MAT, context_);
+  if (options.sundialsKlu) {
     linearSolver_ = SUNLinSol_KLU(y_, jacobian_, context_);
+    linearSystem_ = std::to_string(n) + " unknowns factorised by KLU (SUNDIALS)";
   } else {
     linearSolver_ = makeIdaLinearSolver(model, assembler_.tangent(), ida_, options.corotate, context_);
+    linearSystem_ = idaLinearSolverDescription(linearSolver_);
   }
-  linearSystem_ = dense_ || options.sundialsKlu ? std::to_string(n) + " unknowns factorised by " +
-                                                      (dense_ ? "dense LU (SUNDIALS)" : "KLU (SUNDIALS)")
-                                                : idaLinearSolverDescription(linearSolver_);
   check(IDASetLinearSolver(ida_, linearSolver_, jacobian_), "IDASetLinearSolver");
   check(IDASetJacFn(ida_, jacobian), "IDASetJacFn");
 }
@@ -180,12 +171,6 @@ int IdaProblem::jacobian(realtype t, realtype cj, N_Vector y, N_Vector yp, N_Vec
   self.evaluate(t, y, yp, 1.0, cj);
   const Eigen::SparseMatrix<double>& K = self.assembler_.tangent();
   const int n = self.modelSize_;
-  if (self.dense_) {
-    SUNMatZero(J);
-    for (int col = 0; col < n; ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) SM_ELEMENT_D(J, it.row(), col) = it.value();
-    return 0;
-  }
   sunindextype* colStart = SUNSparseMatrix_IndexPointers(J);
   sunindextype* rowIndex = SUNSparseMatrix_IndexValues(J);
   double* values = SUNSparseMatrix_Data(J);

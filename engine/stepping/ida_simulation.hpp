@@ -1,7 +1,7 @@
 #pragma once
 // The SUNDIALS IDA baseline (run through IDAS, the same BDF solver with quadratures): the model's rate form F(t, z,
 // zdot) = 0 (Component::rateLocal) integrated by variable-order, variable-step BDF with the analytic Jacobian dF/dz +
-// cj dF/dzdot, dense for small models and sparse (engine/stepping/ida_linear_solver.hpp) for large ones. Energies that
+// cj dF/dzdot, factorised by Metriplex's condensed solver (engine/stepping/ida_linear_solver.hpp). Energies that
 // cross the boundary (D' = dissipated power, W' = external power, Q' = boundary heat rate) are IDA quadratures:
 // integrated along, outside the Newton system and the error test.
 #include "engine/stepping/simulation.hpp"
@@ -15,9 +15,9 @@ struct IdaOptions {
   // given), so that a small component is judged relative to its scale rather than to zero.
   double absoluteTolerance = 1e-6;
   int maxOrder = 5;
-  // The Newton matrix of a model above kLargestDenseSystem unknowns goes to Metriplex's sparse
-  // LU (KLU, UMFPACK from kLargeSystem unknowns: engine/linear/sparse_lu.hpp), or with this
-  // set to SUNDIALS' own KLU.
+  // The Newton matrix goes to Metriplex's condensed solver (velocities eliminated, then a dense
+  // LU, KLU or UMFPACK by size: engine/linear/sparse_lu.hpp), or with this set to SUNDIALS' own
+  // KLU on the whole matrix.
   bool sundialsKlu = false;
   // Metriplex's sparse LU: each correction turns the Newton matrix with the scene since it was
   // set up (engine/linear/corotation.hpp)
