@@ -48,8 +48,8 @@ struct NewtonSettings {
   // but the last iterate is less converged than after a fresh Newton step, and the stiff
   // thermal chain's energy balance ends at 1.6e-12 instead of 3e-14 (docs/performance.md).
   double reuseBelowIncrement = 0.0;
-  // Simplified Newton turns a factorisation kept from an earlier step with the scene's rotation
-  // since then (engine/linear/corotation.hpp).
+  // Simplified Newton (and IDA, through Metriplex's solver) turns a factorisation kept from an
+  // earlier step with the scene's rotation since then (engine/linear/corotation.hpp).
   bool corotate = true;
   // Start each step that continues the last one from the polynomial through the last two to
   // four accepted states (eem4: its stages from the same polynomial plus the last step's stage

@@ -31,7 +31,8 @@ double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
 }
 
 void QuadraticConstraint::spatialVectors(std::vector<SpatialVector>& out) const {
-  if (augmented() && spec_.leadingGap)
+  // a gap component implied by other constraints keeps its multipliers at zero: not turned
+  if (augmented() && spec_.leadingGap && !implied_[0] && !implied_[1] && !implied_[2])
     out.push_back({spec_.firstMultiplierDof, spec_.firstMultiplierDof + static_cast<int>(spec_.forms.size()),
                    SpatialVector::Kind::Force});
 }

@@ -54,7 +54,7 @@ class QuadraticConstraint final : public Component {
   bool multipliersHeldAtZero(std::size_t k) const { return implied_[k]; }
 
   void measure(const double* z, Measures& out) const override;
-  // augmented Lagrangian with a leading gap: its lambdas and mus are forces
+  // augmented Lagrangian with a leading gap (none of it implied): its lambdas and mus are forces
   void spatialVectors(std::vector<SpatialVector>& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
