@@ -9,13 +9,11 @@ namespace mpx {
 Corotation::Corotation(const Model& model, int stages) : stateSize_(model.layout().total()), stages_(stages) {
   for (const auto& component : model.components()) component->spatialVectors(vectors_);
   // the configuration's vectors first: they alone fix the rotation
-  std::stable_partition(vectors_.begin(), vectors_.end(), [](const Component::SpatialVector& v) {
+  const auto forces = std::stable_partition(vectors_.begin(), vectors_.end(), [](const Component::SpatialVector& v) {
     return v.kind != Component::SpatialVector::Kind::Force;
   });
-  for (const auto& vector : vectors_) {
-    configuration_ += vector.kind != Component::SpatialVector::Kind::Force ? 1 : 0;
-    points_ += vector.kind == Component::SpatialVector::Kind::Point ? 1 : 0;
-  }
+  configuration_ = static_cast<int>(forces - vectors_.begin());
+  for (int k = 0; k < configuration_; ++k) points_ += isPoint(k) ? 1 : 0;
   anchored_.resize(configuration_);
 }
 
@@ -45,10 +43,9 @@ void Corotation::follow(const Eigen::VectorXd& z) {
   if (points_ > 0) centroid /= points_;
   Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
   for (int k = 0; k < configuration_; ++k) {
-    const Eigen::Vector3d a = isPoint(k) ? Eigen::Vector3d(anchored_[k] - anchoredCentroid_) : anchored_[k];
-    const Eigen::Vector3d b =
-        isPoint(k) ? Eigen::Vector3d(at(z, vectors_[k].first) - centroid) : at(z, vectors_[k].first);
-    correlation += a * b.transpose();
+    const Eigen::Vector3d a = anchored_[k], b = at(z, vectors_[k].first);
+    correlation +=
+        isPoint(k) ? Eigen::Matrix3d((a - anchoredCentroid_) * (b - centroid).transpose()) : a * b.transpose();
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d v = svd.matrixV();

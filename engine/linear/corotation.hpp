@@ -1,16 +1,18 @@
 #pragma once
-// A factorisation kept across steps (simplified Newton) turned with the scene. Where the model
-// is invariant under rotations, its tangent follows the configuration as K(Q z) = Q K(z) Q^T,
-// with Q turning every spatial 3-vector of the state (points and directors, their velocities,
-// the multipliers of constraints that make two points coincide) by one rotation R. A factorisation made at
-// configuration z_f then serves a configuration z close to Q z_f as
+// A factorisation kept across steps (simplified Newton, IDA's Newton matrix) turned with the
+// scene. Where the model is invariant under rotations, its tangent follows the configuration as
+// K(Q z) = Q K(z) Q^T, with Q turning every spatial 3-vector of the state (points and directors,
+// their velocities, the multipliers of constraints that make two points coincide) by one
+// rotation R. A factorisation made at configuration z_f then serves a configuration z close to
+// Q z_f as
 //   dz = -Q K(z_f)^{-1} Q^T r,
 // with R the rotation that best carries z_f's points and directions onto z's (least squares,
-// points about their centroid). A scene that turns as a whole (the flyball governor spins at 2 pi rad/s)
-// keeps one factorisation for many steps this way, where the factorisation taken as it was
-// stops contracting within a few degrees. Scalars, internal variables and the multipliers of
-// scalar constraints are left as they are; where the model is not invariant, or R fits badly, the correction is simply
-// worse and Newton, judged on the true residual, refreshes the factorisation as before.
+// points about their centroid). A scene that turns as a whole (the flyball governor spins at
+// 2 pi rad/s) keeps one factorisation for many steps this way, where the factorisation taken as
+// it was stops contracting within a few degrees. Scalars, internal variables and the
+// multipliers of scalar constraints are left as they are; where the model is not invariant, or
+// R fits badly, the correction is simply worse and Newton, judged on the true residual,
+// refreshes the factorisation as before.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
 

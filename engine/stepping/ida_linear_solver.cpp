@@ -56,12 +56,12 @@ int solve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   Content& c = content(solver);
   const double* in = N_VGetArrayPointer(b);
   std::copy(in, in + c.rhs.size(), c.rhs.data());
-  // the condensed solver gives the Newton increment -A^{-1} b
   const N_Vector y = c.corotation && c.anchored ? currentIterate(c.ida) : nullptr;
   if (y) {
     c.corotation->follow(values(y));
     c.corotation->toAnchor(c.rhs);
   }
+  // the condensed solver gives the Newton increment -A^{-1} b
   c.solver.solve(c.rhs, c.increment);
   if (y) c.corotation->fromAnchor(c.increment);
   double* out = N_VGetArrayPointer(x);
