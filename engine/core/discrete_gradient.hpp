@@ -51,7 +51,9 @@ template <class Fn>
 DiscreteGradient partitionedGradient(const Fn& f, unsigned mask, const Vec3& a, const Vec3& b, const Vec3& scale) {
   // shapleyWeight[n][k]: weight of a subset of size k of the other n-1 arguments
   static constexpr double shapleyWeight[4][3] = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.5, 0}, {1.0 / 3, 1.0 / 6, 1.0 / 3}};
-  const int n = __builtin_popcount(mask);
+  // bits set in a subset of the three arguments (a table: no popcount instruction is assumed)
+  static constexpr int subsetSize[8] = {0, 1, 1, 2, 1, 2, 2, 3};
+  const int n = subsetSize[mask & 7u];
 
   // corners of the box, evaluated lazily: argument j at b when bit j of the subset is set
   Jet corner[8];
@@ -78,7 +80,7 @@ DiscreteGradient partitionedGradient(const Fn& f, unsigned mask, const Vec3& a, 
     const bool tiny = isTinyIncrement(a[i], b[i], scale[i]);
     for (unsigned subset = 0; subset < 8; ++subset) {
       if ((subset & ~mask) || (subset & bitI)) continue;
-      const double w = shapleyWeight[n][__builtin_popcount(subset)];
+      const double w = shapleyWeight[n][subsetSize[subset]];
       // the 0/0 limit: derivative at the midpoint of the i-th edge, no raw tiny division
       if (tiny) {
         Vec3 mid = cornerPoint(subset);

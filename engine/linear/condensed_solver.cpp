@@ -66,17 +66,17 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   // and the single velocity entry d_i
   kinematicRows_.assign(nv, {});
   pivotEntry_.assign(nv, -1);
-  kinematicColumnStart_.assign(n + 1, 0);
-  kinematicColumns_.clear();
+  std::vector<int> termStart(n + 1, 0);
+  kinematicTerms_.clear();
   for (int column = 0; column < n; ++column) {
-    kinematicColumnStart_[column] = static_cast<int>(kinematicColumns_.size());
+    termStart[column] = static_cast<int>(kinematicTerms_.size());
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
       const int row = static_cast<int>(it.row()), k = kinematicIndex_[row];
       if (k < 0) continue;
       const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
       if (!isVelocity(column)) {
         kinematicRows_[k].push_back({column, entry});
-        kinematicColumns_.push_back({k, entry});
+        kinematicTerms_.push_back({k, entry});
       } else if (column == velocityOf(k))
         pivotEntry_[k] = entry;
       else {
@@ -86,12 +86,24 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
       }
     }
   }
-  kinematicColumnStart_[n] = static_cast<int>(kinematicColumns_.size());
+  termStart[n] = static_cast<int>(kinematicTerms_.size());
+  termFactor_.assign(kinematicTerms_.size(), 0.0);
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
     wholeSystemReason_ = "position " + dofName(kinematicRow_[missing - pivotEntry_.begin()]) +
                          " has no kinematic row (no inertia owns it)";
     return false;
   }
+
+  // each velocity column's entries in kept rows (the momentum rows of K(j, v_i))
+  couplingStart_.assign(nv + 1, 0);
+  velocityCouplings_.clear();
+  for (int i = 0; i < nv; ++i) {
+    couplingStart_[i] = static_cast<int>(velocityCouplings_.size());
+    for (SparseMatrix::InnerIterator it(pattern, velocityOf(i)); it; ++it)
+      if (!isPosition(static_cast<int>(it.row())))
+        velocityCouplings_.push_back({reducedIndex_[it.row()], static_cast<int>(&it.value() - pattern.valuePtr())});
+  }
+  couplingStart_[nv] = static_cast<int>(velocityCouplings_.size());
 
   // condensed pattern, a column at a time: the kept entries of K, plus the fill of the
   // products K(j, v_i) K(q_i, c), each entry once (the products are many times the entries)
@@ -99,16 +111,18 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   std::vector<int> rows;
   std::vector<char> seen(n - nv, 0);
   auto mark = [&](int row) {
-    if (isPosition(row) || seen[reducedIndex_[row]]) return;
-    seen[reducedIndex_[row]] = 1;
-    rows.push_back(reducedIndex_[row]);
+    if (seen[row]) return;
+    seen[row] = 1;
+    rows.push_back(row);
   };
   for (int column = 0; column < n; ++column) {
     if (isVelocity(column)) continue;
-    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) mark(static_cast<int>(it.row()));
-    for (int k = kinematicColumnStart_[column]; k < kinematicColumnStart_[column + 1]; ++k)
-      for (SparseMatrix::InnerIterator it(pattern, velocityOf(kinematicColumns_[k].row)); it; ++it)
-        mark(static_cast<int>(it.row()));
+    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
+      if (!isPosition(static_cast<int>(it.row()))) mark(reducedIndex_[it.row()]);
+    for (int term = termStart[column]; term < termStart[column + 1]; ++term) {
+      const int i = kinematicTerms_[term].row;
+      for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e) mark(velocityCouplings_[e].row);
+    }
     for (const int row : rows) {
       entries.emplace_back(row, reducedIndex_[column], 0.0);
       seen[row] = 0;
@@ -118,7 +132,26 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   reduced_.resize(n - nv, n - nv);
   reduced_.setFromTriplets(entries.begin(), entries.end());
   reduced_.makeCompressed();
-  condensedColumn_.setZero(n - nv);
+
+  // the terms of each condensed entry, column by column: where each kept row of a column sits in
+  // the condensed values, then its copies and products in the order of the rows and of i
+  std::vector<int> place(n - nv, -1);
+  copies_.clear();
+  products_.clear();
+  for (int column = 0; column < n; ++column) {
+    if (isVelocity(column)) continue;
+    const int target = reducedIndex_[column];
+    for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e)
+      place[reduced_.innerIndexPtr()[e]] = e;
+    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
+      if (!isPosition(static_cast<int>(it.row())))
+        copies_.push_back({place[reducedIndex_[it.row()]], static_cast<int>(&it.value() - pattern.valuePtr())});
+    for (int term = termStart[column]; term < termStart[column + 1]; ++term) {
+      const int i = kinematicTerms_[term].row;
+      for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e)
+        products_.push_back({place[velocityCouplings_[e].row], velocityCouplings_[e].entry, term});
+    }
+  }
   return true;
 }
 
@@ -130,28 +163,17 @@ bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
 }
 
 void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
+  // each condensed value: its entries of K, minus the products K(j, v_i) K(q_i, c) / d_i
   const double* k = tangent.valuePtr();
-  const int n = static_cast<int>(tangent.rows());
   double* reduced = reduced_.valuePtr();
-  // each condensed column in a dense work column: K(j, c), minus the products in the order of
-  // i, then copied into the condensed values (the work column is zero again afterwards)
-  for (int column = 0; column < n; ++column) {
-    if (isVelocity(column)) continue;
-    for (SparseMatrix::InnerIterator it(tangent, column); it; ++it)
-      if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] += it.value();
-    for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
-      const auto [i, kinematicEntry] = kinematicColumns_[term];
-      const double factor = k[kinematicEntry] / k[pivotEntry_[i]];
-      for (SparseMatrix::InnerIterator it(tangent, velocityOf(i)); it; ++it)
-        if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] -= it.value() * factor;
-    }
-    const int target = reducedIndex_[column];
-    for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e) {
-      double& value = condensedColumn_[reduced_.innerIndexPtr()[e]];
-      reduced[e] = value;
-      value = 0.0;
-    }
+  for (std::size_t term = 0; term < kinematicTerms_.size(); ++term) {
+    const auto [i, kinematicEntry] = kinematicTerms_[term];
+    termFactor_[term] = k[kinematicEntry] / k[pivotEntry_[i]];
   }
+  std::fill_n(reduced, reduced_.nonZeros(), 0.0);
+  for (const CondensedCopy& copy : copies_) reduced[copy.target] += k[copy.source];
+  for (const CondensedProduct& product : products_)
+    reduced[product.target] -= k[product.source] * termFactor_[product.term];
 }
 
 void CondensedSolver::solveVelocityCondensed(Eigen::VectorXd& rhs) {
@@ -180,8 +202,8 @@ void CondensedSolver::solve(const Eigen::VectorXd& residual, Eigen::VectorXd& in
     if (!isPosition(row)) reducedRhs_[reducedIndex_[row]] = -residual[row];
   for (int i = 0; i < nv; ++i) {
     const double factor = residual[kinematicRow_[i]] / k[pivotEntry_[i]];
-    for (SparseMatrix::InnerIterator it(K, velocityOf(i)); it; ++it)
-      if (!isPosition(static_cast<int>(it.row()))) reducedRhs_[reducedIndex_[it.row()]] += it.value() * factor;
+    for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e)
+      reducedRhs_[velocityCouplings_[e].row] += k[velocityCouplings_[e].entry] * factor;
   }
   solveVelocityCondensed(reducedRhs_);
 

@@ -33,8 +33,10 @@ LumpedElement::LumpedElement(LumpedElementSpec spec) : Component(spec.name, coll
   linearEntropy_ = spec_.law->linearEntropy();
 }
 
-Vec3 LumpedElement::arguments(const double* z) const {
-  return {geometry_ ? geometry_->separation(z).squaredNorm() : 0.0, localThermal_ >= 0 ? z[spec_.thermalDof] : 0.0,
+Vec3 LumpedElement::separation(const double* z) const { return geometry_ ? geometry_->separation(z) : Vec3::Zero(); }
+
+Vec3 LumpedElement::arguments(const double* z, const Vec3& separation) const {
+  return {separation.squaredNorm(), localThermal_ >= 0 ? z[spec_.thermalDof] : 0.0,
           localInternal_ >= 0 ? z[spec_.internalDof] : 0.0};
 }
 
@@ -116,7 +118,8 @@ void LumpedElement::addBalances(const Response& response, double zCoefficient, c
 }
 
 void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
-  const Vec3 a = arguments(args.zOld), b = arguments(args.zNew);
+  const Vec3 separationOld = separation(args.zOld), separationNew = separation(args.zNew);
+  const Vec3 a = arguments(args.zOld, separationOld), b = arguments(args.zNew, separationNew);
   auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
   auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
   const bool gonzalez = spec_.form == DiscreteGradientForm::Gonzalez;
@@ -130,9 +133,8 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
 
   // derivatives of the end-point arguments b with respect to zNew
   LocalRow rows[3];
-  Vec3 separationMid = Vec3::Zero();
-  if (geometry_) separationMid = 0.5 * (geometry_->separation(args.zOld) + geometry_->separation(args.zNew));
-  argumentRows(geometry_ ? geometry_->separation(args.zNew) : Vec3::Zero(), rows, args.tangent);
+  const Vec3 separationMid = 0.5 * (separationOld + separationNew);
+  argumentRows(separationNew, rows, args.tangent);
   const Response response = respond(alongRows(dEnergy, rows), alongRows(dEntropy, rows));
 
   const double gammaRate = (b[2] - a[2]) / args.dt;
@@ -148,12 +150,12 @@ void LumpedElement::eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& o
 }
 
 void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
-  const Vec3 a = arguments(args.z);
+  const Vec3 separation = this->separation(args.z);
+  const Vec3 a = arguments(args.z, separation);
   const Jet energy = spec_.law->energy(a);
   const Jet entropy = spec_.law->entropy(a);
 
   LocalRow rows[3];
-  const Vec3 separation = geometry_ ? geometry_->separation(args.z) : Vec3::Zero();
   const bool tangent = args.alpha != 0.0 || args.beta != 0.0;
   argumentRows(separation, rows, tangent);
   const Response response = respond(alongRows(exactGradient(energy), rows), alongRows(exactGradient(entropy), rows));
@@ -183,15 +185,16 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
   const CollocationRule& rule = *args.rule;
   StagePath path;
   path.column = args.column;
-  path.start = arguments(args.zOld);
-  path.end = arguments(args.zEnd);
-  argumentRows(geometry_ ? geometry_->separation(args.zEnd) : Vec3::Zero(), path.endRows, args.tangent);
+  const Vec3 separationEnd = separation(args.zEnd);
+  path.start = arguments(args.zOld, separation(args.zOld));
+  path.end = arguments(args.zEnd, separationEnd);
+  argumentRows(separationEnd, path.endRows, args.tangent);
   for (int j = 0; j < rule.stages; ++j) {
     const double* z = args.stageState[j];
     const double* zdot = args.stageRate[j];
-    const Vec3 separation = geometry_ ? geometry_->separation(z) : Vec3::Zero();
+    const Vec3 separation = this->separation(z);
     const Vec3 separationRate = geometry_ ? geometry_->separationRate(zdot) : Vec3::Zero();
-    path.value[j] = arguments(z);
+    path.value[j] = arguments(z, separation);
     // tau-rates a' = dt (2 d . d', s', gamma')
     path.rate[j] =
         args.dt * Vec3(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
@@ -228,7 +231,7 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   const Vec3& rate = path.rate[l];
   const double gammaRate = rate[2] / args.dt;
   const double entropyRate = dEntropy.grad.dot(rate) / args.dt;
-  const Vec3 separation = geometry_ ? geometry_->separation(args.stageState[l]) : Vec3::Zero();
+  const Vec3 separation = this->separation(args.stageState[l]);
   addBalances(response, 1.0, 2.0 * separation, gammaRate, entropyRate, ws, out, flows);
   if (!args.tangent) return;
 
@@ -245,7 +248,7 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
 }
 
 void LumpedElement::measure(const double* z, Measures& out) const {
-  const Vec3 a = arguments(z);
+  const Vec3 a = arguments(z, separation(z));
   const Jet energy = spec_.law->energy(a);
   const Jet entropy = spec_.law->entropy(a);
   out.energy += energy.value;

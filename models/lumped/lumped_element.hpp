@@ -58,7 +58,9 @@ class LumpedElement final : public Component {
     LocalRow dForce, dTheta, dDrivingForce, dViscosity;
   };
   static std::vector<int> collectDofs(const LumpedElementSpec& spec);
-  Vec3 arguments(const double* z) const;
+  // The separation d of the two ends (zero without ends), and the arguments (c = |d|^2, s, gamma).
+  Vec3 separation(const double* z) const;
+  Vec3 arguments(const double* z, const Vec3& separation) const;
   // From the (discrete) gradients of energy and entropy over (c, s, gamma).
   Response respond(const GradientRows& dEnergy, const GradientRows& dEntropy) const;
   // Rows over local dofs of d(c, s, gamma)/dz, c's at separation d; empty without a tangent,
