@@ -66,17 +66,17 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   // and the single velocity entry d_i
   kinematicRows_.assign(nv, {});
   pivotEntry_.assign(nv, -1);
-  std::vector<int> termStart(n + 1, 0);
-  kinematicTerms_.clear();
+  kinematicColumnStart_.assign(n + 1, 0);
+  kinematicColumns_.clear();
   for (int column = 0; column < n; ++column) {
-    termStart[column] = static_cast<int>(kinematicTerms_.size());
+    kinematicColumnStart_[column] = static_cast<int>(kinematicColumns_.size());
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it) {
       const int row = static_cast<int>(it.row()), k = kinematicIndex_[row];
       if (k < 0) continue;
       const int entry = static_cast<int>(&it.value() - pattern.valuePtr());
       if (!isVelocity(column)) {
         kinematicRows_[k].push_back({column, entry});
-        kinematicTerms_.push_back({k, entry});
+        kinematicColumns_.push_back({k, entry});
       } else if (column == velocityOf(k))
         pivotEntry_[k] = entry;
       else {
@@ -86,8 +86,7 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
       }
     }
   }
-  termStart[n] = static_cast<int>(kinematicTerms_.size());
-  termFactor_.assign(kinematicTerms_.size(), 0.0);
+  kinematicColumnStart_[n] = static_cast<int>(kinematicColumns_.size());
   if (const auto missing = std::find(pivotEntry_.begin(), pivotEntry_.end(), -1); missing != pivotEntry_.end()) {
     wholeSystemReason_ = "position " + dofName(kinematicRow_[missing - pivotEntry_.begin()]) +
                          " has no kinematic row (no inertia owns it)";
@@ -119,8 +118,8 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
     if (isVelocity(column)) continue;
     for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
       if (!isPosition(static_cast<int>(it.row()))) mark(reducedIndex_[it.row()]);
-    for (int term = termStart[column]; term < termStart[column + 1]; ++term) {
-      const int i = kinematicTerms_[term].row;
+    for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
+      const int i = kinematicColumns_[term].row;
       for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e) mark(velocityCouplings_[e].row);
     }
     for (const int row : rows) {
@@ -132,26 +131,7 @@ bool CondensedSolver::buildCondensation(const SparseMatrix& pattern) {
   reduced_.resize(n - nv, n - nv);
   reduced_.setFromTriplets(entries.begin(), entries.end());
   reduced_.makeCompressed();
-
-  // the terms of each condensed entry, column by column: where each kept row of a column sits in
-  // the condensed values, then its copies and products in the order of the rows and of i
-  std::vector<int> place(n - nv, -1);
-  copies_.clear();
-  products_.clear();
-  for (int column = 0; column < n; ++column) {
-    if (isVelocity(column)) continue;
-    const int target = reducedIndex_[column];
-    for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e)
-      place[reduced_.innerIndexPtr()[e]] = e;
-    for (SparseMatrix::InnerIterator it(pattern, column); it; ++it)
-      if (!isPosition(static_cast<int>(it.row())))
-        copies_.push_back({place[reducedIndex_[it.row()]], static_cast<int>(&it.value() - pattern.valuePtr())});
-    for (int term = termStart[column]; term < termStart[column + 1]; ++term) {
-      const int i = kinematicTerms_[term].row;
-      for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e)
-        products_.push_back({place[velocityCouplings_[e].row], velocityCouplings_[e].entry, term});
-    }
-  }
+  condensedColumn_.setZero(n - nv);
   return true;
 }
 
@@ -163,17 +143,29 @@ bool CondensedSolver::factorize(const SparseMatrix& tangent, bool repivot) {
 }
 
 void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
-  // each condensed value: its entries of K, minus the products K(j, v_i) K(q_i, c) / d_i
   const double* k = tangent.valuePtr();
+  const int n = static_cast<int>(tangent.rows());
   double* reduced = reduced_.valuePtr();
-  for (std::size_t term = 0; term < kinematicTerms_.size(); ++term) {
-    const auto [i, kinematicEntry] = kinematicTerms_[term];
-    termFactor_[term] = k[kinematicEntry] / k[pivotEntry_[i]];
+  // each condensed column in a dense work column: K(j, c), minus the products in the order of
+  // i, then copied into the condensed values (the work column is zero again afterwards); the
+  // products are never stored: a rigid link has some 42 000 of them (docs/performance.md)
+  for (int column = 0; column < n; ++column) {
+    if (isVelocity(column)) continue;
+    for (SparseMatrix::InnerIterator it(tangent, column); it; ++it)
+      if (!isPosition(static_cast<int>(it.row()))) condensedColumn_[reducedIndex_[it.row()]] += it.value();
+    for (int term = kinematicColumnStart_[column]; term < kinematicColumnStart_[column + 1]; ++term) {
+      const auto [i, kinematicEntry] = kinematicColumns_[term];
+      const double factor = k[kinematicEntry] / k[pivotEntry_[i]];
+      for (int e = couplingStart_[i]; e < couplingStart_[i + 1]; ++e)
+        condensedColumn_[velocityCouplings_[e].row] -= k[velocityCouplings_[e].entry] * factor;
+    }
+    const int target = reducedIndex_[column];
+    for (int e = reduced_.outerIndexPtr()[target]; e < reduced_.outerIndexPtr()[target + 1]; ++e) {
+      double& value = condensedColumn_[reduced_.innerIndexPtr()[e]];
+      reduced[e] = value;
+      value = 0.0;
+    }
   }
-  std::fill_n(reduced, reduced_.nonZeros(), 0.0);
-  for (const CondensedCopy& copy : copies_) reduced[copy.target] += k[copy.source];
-  for (const CondensedProduct& product : products_)
-    reduced[product.target] -= k[product.source] * termFactor_[product.term];
 }
 
 void CondensedSolver::solveVelocityCondensed(Eigen::VectorXd& rhs) {

@@ -60,15 +60,6 @@ class CondensedSolver {
   struct ColumnEntry {
     int row, entry;
   };
-  // A condensed entry's terms, compiled from the pattern: an entry of K copied, or a product
-  // K(j, v_i) K(q_i, c) / d_i subtracted, with `source` the place of K(j, v_i) and `term` the
-  // kinematic entry K(q_i, c) whose factor it takes; `target` is the place in the condensed values.
-  struct CondensedCopy {
-    int target, source;
-  };
-  struct CondensedProduct {
-    int target, source, term;
-  };
   // A velocity column's entry in a kept row: the row's condensed index and its place in K.
   struct VelocityCoupling {
     int row, entry;
@@ -108,14 +99,11 @@ class CondensedSolver {
   Eigen::SparseMatrix<double> reduced_;
   std::vector<int> pivotEntry_;                       // per kinematic row i (all stages): place of d_i in K
   std::vector<std::vector<RowEntry>> kinematicRows_;  // per kinematic row i (all stages)
-  // the kinematic entries of K off the velocities, column by column, in the order of i, with
-  // each one's factor K(q_i, c) / d_i during a condensation
-  std::vector<ColumnEntry> kinematicTerms_;
-  std::vector<double> termFactor_;
-  // the condensed values as the copies, then the products, in the order of the columns of K:
-  // per condensed entry the sums of the dense column elimination they replace, term for term
-  std::vector<CondensedCopy> copies_;
-  std::vector<CondensedProduct> products_;
+  // the kinematic entries of column c of K are kinematicColumns_[kinematicColumnStart_[c] ...
+  // kinematicColumnStart_[c + 1]), in the order of i
+  std::vector<ColumnEntry> kinematicColumns_;
+  std::vector<int> kinematicColumnStart_;
+  Eigen::VectorXd condensedColumn_;  // zero between uses
   // per kinematic row i, its velocity column's entries in kept rows:
   // velocityCouplings_[couplingStart_[i] ... couplingStart_[i + 1])
   std::vector<VelocityCoupling> velocityCouplings_;
