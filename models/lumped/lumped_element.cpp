@@ -74,10 +74,10 @@ LumpedElement::Response LumpedElement::respond(const GradientRows& dEnergy, cons
   r.dForce = dEnergy.d[0] - r.theta * dEntropy.d[0] - dEntropy.grad[0] * r.dTheta;
   r.drivingForce = -(dEnergy.grad[2] - r.theta * dEntropy.grad[2]);
   r.dDrivingForce = -(dEnergy.d[2] - r.theta * dEntropy.d[2]) + dEntropy.grad[2] * r.dTheta;
-  // viscosity at the (discrete) temperature
+  // viscosity at the (discrete) temperature, which only an internal variable's flow uses
   const Viscosity& v = spec_.viscosity;
   r.viscosity = v.reference;
-  if (mask_ & kThermalBit) {
+  if ((mask_ & kThermalBit) && (mask_ & kInternalBit)) {
     r.viscosity *= std::exp(-v.activation * (r.theta - v.referenceTemperature));
     r.dViscosity = -v.activation * r.viscosity * r.dTheta;
   }
@@ -110,9 +110,13 @@ void LumpedElement::addBalances(const Response& response, double zCoefficient, c
   if (localInternal_ >= 0)
     K.row(localInternal_) += zCoefficient * (gammaRate * response.dViscosity - response.dDrivingForce);
   if (localThermal_ >= 0) {
-    const LocalRow dDissipation = (2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity;
-    K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta -
-                                            (localInternal_ >= 0 ? dDissipation : LocalRow::Zero(r.size())));
+    // theta times the entropy rate, less the viscous heating g^2/nu where an internal variable flows
+    if (localInternal_ >= 0) {
+      const LocalRow dDissipation = (2.0 * g / nu) * response.dDrivingForce - (g * g / (nu * nu)) * response.dViscosity;
+      K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta - dDissipation);
+    } else {
+      K.row(localThermal_) += zCoefficient * (entropyRate * response.dTheta);
+    }
     Eigen::Map<LocalRow>(ws.nodes[spec_.thermalNode].grad, out.n) = zCoefficient * response.dTheta;
   }
 }
