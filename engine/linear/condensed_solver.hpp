@@ -56,12 +56,9 @@ class CondensedSolver {
   struct RowEntry {
     int column, entry;
   };
-  // The same entry seen from its column: the kinematic row i and its place in K.
+  // An entry seen from its column: its row (a kinematic row i, or a kept row's condensed index)
+  // and its place in K.
   struct ColumnEntry {
-    int row, entry;
-  };
-  // A velocity column's entry in a kept row: the row's condensed index and its place in K.
-  struct VelocityCoupling {
     int row, entry;
   };
   // The maps below for `stages` copies of a layout of n dofs with `positions` positions.
@@ -106,7 +103,7 @@ class CondensedSolver {
   Eigen::VectorXd condensedColumn_;  // zero between uses
   // per kinematic row i, its velocity column's entries in kept rows:
   // velocityCouplings_[couplingStart_[i] ... couplingStart_[i + 1])
-  std::vector<VelocityCoupling> velocityCouplings_;
+  std::vector<ColumnEntry> velocityCouplings_;
   std::vector<int> couplingStart_;
   Eigen::VectorXd reducedRhs_;
   GroupElimination internal_;

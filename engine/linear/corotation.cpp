@@ -21,13 +21,16 @@ namespace {
 Eigen::Vector3d at(const Eigen::VectorXd& z, int dof) { return z.segment<3>(dof); }
 }  // namespace
 
+Eigen::Vector3d Corotation::pointCentroid(const Eigen::VectorXd& z) const {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (int k = 0; k < configuration_; ++k)
+    if (isPoint(k)) centroid += at(z, vectors_[k].first);
+  return points_ > 0 ? Eigen::Vector3d(centroid / points_) : centroid;
+}
+
 void Corotation::anchor(const Eigen::VectorXd& z) {
-  anchoredCentroid_.setZero();
-  for (int k = 0; k < configuration_; ++k) {
-    anchored_[k] = at(z, vectors_[k].first);
-    if (isPoint(k)) anchoredCentroid_ += anchored_[k];
-  }
-  if (points_ > 0) anchoredCentroid_ /= points_;
+  for (int k = 0; k < configuration_; ++k) anchored_[k] = at(z, vectors_[k].first);
+  anchoredCentroid_ = pointCentroid(z);
   rotation_.setIdentity();
   turned_ = false;
 }
@@ -37,10 +40,7 @@ void Corotation::follow(const Eigen::VectorXd& z) {
   // Kabsch: R = V U^T from the SVD U S V^T of the correlation sum a b^T of the anchored
   // vectors a and the current ones b (points about their centroids, directions as they are),
   // with the last singular direction flipped if that gives a reflection
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (int k = 0; k < configuration_; ++k)
-    if (isPoint(k)) centroid += at(z, vectors_[k].first);
-  if (points_ > 0) centroid /= points_;
+  const Eigen::Vector3d centroid = pointCentroid(z);
   Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
   for (int k = 0; k < configuration_; ++k) {
     const Eigen::Vector3d a = anchored_[k], b = at(z, vectors_[k].first);
@@ -52,6 +52,18 @@ void Corotation::follow(const Eigen::VectorXd& z) {
   if ((v * svd.matrixU().transpose()).determinant() < 0.0) v.col(2) *= -1.0;
   rotation_ = v * svd.matrixU().transpose();
   turned_ = !rotation_.isIdentity(0.0);
+}
+
+void Corotation::solve(CondensedSolver& solver, const Eigen::VectorXd& residual, Eigen::VectorXd& work,
+                       Eigen::VectorXd& increment) const {
+  if (!turned_) {
+    solver.solve(residual, increment);
+    return;
+  }
+  work = residual;
+  toAnchor(work);
+  solver.solve(work, increment);
+  fromAnchor(increment);
 }
 
 void Corotation::turn(Eigen::VectorXd& v, const Eigen::Matrix3d& rotation) const {

@@ -15,6 +15,7 @@
 // refreshes the factorisation as before.
 #include "engine/core/component.hpp"
 #include "engine/core/model.hpp"
+#include "engine/linear/condensed_solver.hpp"
 
 #include <Eigen/Dense>
 
@@ -37,9 +38,15 @@ class Corotation {
   // from it (R), in every stage.
   void toAnchor(Eigen::VectorXd& v) const { turn(v, rotation_.transpose()); }
   void fromAnchor(Eigen::VectorXd& v) const { turn(v, rotation_); }
+  // increment = the correction for `residual` from `solver`'s factorisation, made at the anchor,
+  // turned with the scene: R K_f^{-1} R^T applied (`work` holds the residual in the anchor's frame).
+  void solve(CondensedSolver& solver, const Eigen::VectorXd& residual, Eigen::VectorXd& work,
+             Eigen::VectorXd& increment) const;
 
  private:
   void turn(Eigen::VectorXd& v, const Eigen::Matrix3d& rotation) const;
+  // the centroid of z's points (zero without points)
+  Eigen::Vector3d pointCentroid(const Eigen::VectorXd& z) const;
   bool isPoint(int k) const { return vectors_[k].kind == Component::SpatialVector::Kind::Point; }
 
   // the configuration's vectors (points and directions) first, configuration_ of them

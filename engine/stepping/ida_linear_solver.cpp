@@ -17,8 +17,8 @@ namespace {
 
 struct Content {
   CondensedSolver solver;
-  Eigen::SparseMatrix<double> matrix;  // the pattern, with the values of the last setup
-  Eigen::VectorXd rhs, increment;
+  Eigen::SparseMatrix<double> matrix;      // the pattern, with the values of the last setup
+  Eigen::VectorXd rhs, increment, turned;  // turned: the right-hand side in the anchor's frame
   // IDA keeps its Newton matrix over many steps: it turns with the scene (null: as it was),
   // from where it was set up if that was within a step (IDA's initial condition has no iterate)
   std::optional<Corotation> corotation;
@@ -56,14 +56,14 @@ int solve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   Content& c = content(solver);
   const double* in = N_VGetArrayPointer(b);
   std::copy(in, in + c.rhs.size(), c.rhs.data());
+  // the condensed solver gives the Newton increment -A^{-1} b (turned from where A was set up)
   const N_Vector y = c.corotation && c.anchored ? currentIterate(c.ida) : nullptr;
   if (y) {
     c.corotation->follow(values(y));
-    c.corotation->toAnchor(c.rhs);
+    c.corotation->solve(c.solver, c.rhs, c.turned, c.increment);
+  } else {
+    c.solver.solve(c.rhs, c.increment);
   }
-  // the condensed solver gives the Newton increment -A^{-1} b
-  c.solver.solve(c.rhs, c.increment);
-  if (y) c.corotation->fromAnchor(c.increment);
   double* out = N_VGetArrayPointer(x);
   for (Eigen::Index i = 0; i < c.increment.size(); ++i) out[i] = -c.increment[i];
   return SUNLS_SUCCESS;
@@ -84,6 +84,7 @@ SUNLinearSolver makeIdaLinearSolver(const Model& model, const Eigen::SparseMatri
   // IDA keeps a Newton matrix for many steps: its solves, not its factorisations, dominate
   auto* c = new Content{CondensedSolver(model.layout(), pattern, false, kManySolvesSystem),
                         pattern,
+                        Eigen::VectorXd(pattern.rows()),
                         Eigen::VectorXd(pattern.rows()),
                         Eigen::VectorXd(pattern.rows()),
                         std::nullopt,

@@ -339,14 +339,7 @@ bool Integrator::refactorize(const Eigen::VectorXd& zOld, double dt, bool repivo
 }
 
 void Integrator::correct(const Eigen::VectorXd& residual) {
-  if (!corotation_.turned()) {
-    solver_.solve(residual, increment_);
-    return;
-  }
-  turnedResidual_ = residual;
-  corotation_.toAnchor(turnedResidual_);
-  solver_.solve(turnedResidual_, increment_);
-  corotation_.fromAnchor(increment_);
+  corotation_.solve(solver_, residual, turnedResidual_, increment_);
 }
 
 double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,

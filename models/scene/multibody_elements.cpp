@@ -68,7 +68,7 @@ void buildBody(ElementReader& in, SceneBuild& build, DofRange& dofs) {
       name, phi, phiRate, std::vector<InertiaBlock>{{mass, true}, {E[0], false}, {E[1], false}, {E[2], false}},
       build.spec.gravity));
   const JointBuilder builder(build.attachments[name]);
-  build.addConstraint(name + ".rigidity", builder, builder.rigidity(), false, rigidity, dofs);
+  build.addConstraint(name + ".rigidity", builder, builder.rigidity(), /*leadingGap=*/false, rigidity, dofs);
 }
 
 DofDemand declareJoint(ElementReader& in, SceneBuild& build) {
