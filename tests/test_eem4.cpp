@@ -1,8 +1,10 @@
 // The fourth-order EEM step (eem4: energy-consistent two-stage Gauss collocation, docs/theory.md
 // section 13): observed order 4 against a fine run, the energy balance and entropy production at
 // every step also at large steps, exact momenta, the stability of a stiff linear dissipative
-// mode, and the refusal of an element without a stage form.
+// mode, the refusal of an element without a stage form, and the stage passes that share a
+// component's path.
 #include "support.hpp"
+#include "tangent_check.hpp"
 
 #include "engine/core/input_error.hpp"
 #include "engine/linear/assembler.hpp"
@@ -288,6 +290,46 @@ TEST(Eem4Scope, RefusesAnElementWithoutAStageForm) {
   }
   for (const char* scene : {"lblock_thermoelastic.xml", "lblock_thermal_dirichlet.xml"})
     EXPECT_NO_THROW(checkMethodSupports(*methodByName("eem4"), *loadScene(scenePath(scene)).model, scene));
+}
+
+// An eem4 evaluation passes over the components once per pair of stages (once per stage for a
+// residual alone), and after its first pass a component takes its stage path and its law's jets
+// from its scratch in the workspace (StageArgs::samePath). The assembled residual and tangent
+// are those of passes that compute everything afresh (a workspace without scratch), bit for bit:
+// at two states in turn, each with and without the tangent, so that a path kept from an earlier
+// evaluation would show.
+TEST(Eem4StageScratch, SharedPassesGiveWhatFreshPassesGive) {
+  const CollocationRule rule = gaussCollocation(2);
+  for (const char* name : {"two_thermo_springs.xml", "thermo_visco_elastic.xml", "damped_double_pendulum.xml"}) {
+    SCOPED_TRACE(name);
+    const CompiledScene scene = loadScene(scenePath(name));
+    const Model& model = *scene.model;
+    const Eigen::VectorXd zOld = model.initialState(), magnitude = magnitudeAt(model, zOld);
+    Workspace kept = model.makeWorkspace(), fresh = model.makeWorkspace();
+    fresh.stageScratch.clear();
+    Assembler sharing(model, Component::LocalForm::Stages, 2), afresh(model, Component::LocalForm::Stages, 2);
+    for (unsigned seed : {3u, 5u}) {
+      Eigen::VectorXd values[2], rates[2];
+      for (int l = 0; l < 2; ++l) {
+        values[l] = zOld + 1e-2 * randomIsh(magnitude, seed + 10 * l);
+        rates[l] = randomIsh(magnitude, seed + 10 * l + 1);
+      }
+      const Eigen::VectorXd zEnd = zOld + 1e-2 * randomIsh(magnitude, seed + 100);
+      const double* state[2] = {values[0].data(), values[1].data()};
+      const double* rate[2] = {rates[0].data(), rates[1].data()};
+      for (bool tangent : {true, false}) {
+        const StageArgs args{&rule, zOld.data(), zEnd.data(), state, rate, 0.3, 0.1, 0, 0, tangent};
+        sharing.clear(tangent);
+        sharing.addStages(model, kept, args);
+        afresh.clear(tangent);
+        afresh.addStages(model, fresh, args);
+        EXPECT_TRUE(sharing.residual() == afresh.residual()) << "seed " << seed << ", tangent " << tangent;
+        if (tangent) {
+          EXPECT_TRUE(Eigen::MatrixXd(sharing.tangent()) == Eigen::MatrixXd(afresh.tangent())) << "seed " << seed;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,9 +29,17 @@ struct NodeTemperature {
   double grad[kMaxLocalDofs] = {};
 };
 
+// What a component's stage form computes once per eem4 evaluation and takes up again in the
+// evaluation's later passes (StageArgs::samePath): the path of its arguments, its law's jets.
+struct StageScratch {
+  virtual ~StageScratch() = default;
+};
+
 // Scratch shared by the components of one evaluation, allocated once per model.
 struct Workspace {
   std::vector<NodeTemperature> nodes;
+  // per component, in the model's order; null where a component keeps none
+  std::vector<std::unique_ptr<StageScratch>> stageScratch;
 };
 
 // One EEM step from zOld at time t to zNew at time t + dt. Without `tangent` only the residual
@@ -57,7 +66,9 @@ struct RateArgs {
 // passes through zOld and the stage values; stageState[l] and stageRate[l] are z and z' at
 // t + c_l dt, zEnd is z(t + dt). Wanted: the residual of stage `stage` and its derivative with
 // respect to the values of stage `column`; without `tangent`, the residual alone (column =
-// stage), and a component may skip the tangent.
+// stage), and a component may skip the tangent. With `samePath` the component was called at
+// the same stage values before in this evaluation (a later pass over the stages and columns):
+// what depends on neither `stage` nor `column` may be taken from its stage scratch.
 struct StageArgs {
   const CollocationRule* rule;
   const double* zOld;
@@ -69,6 +80,7 @@ struct StageArgs {
   int stage;
   int column;
   bool tangent = true;
+  bool samePath = false;
   // The rate form at this stage, with the coefficients of the tangent for stage `column` (none
   // without `tangent`).
   RateArgs rateArgs() const {
@@ -167,6 +179,8 @@ class Component {
   enum class StageForm { None, RateAtStages, Own };
   virtual StageForm stageForm() const { return StageForm::None; }
   virtual void stageLocal(const StageArgs& /*args*/, Workspace& /*ws*/, LocalSystem& /*out*/, Flows& /*flows*/) const {}
+  // The stage scratch a model's workspace holds for this component (none by default).
+  virtual std::unique_ptr<StageScratch> makeStageScratch() const { return nullptr; }
   // A residual-only eem4 evaluation: a component whose stages share work (a solid cell: each
   // point's path through all stages) gives every stage's residual at once, out[l] and flows[l]
   // for stage l, in place of one stageLocal per stage. Such a component neither publishes nor
@@ -177,10 +191,19 @@ class Component {
 
  protected:
   Component(std::string name, std::vector<int> dofs) : name_(std::move(name)), dofs_(std::move(dofs)) {}
+  // This component's stage scratch in `ws` (made by makeStageScratch), or null: outside a
+  // model's workspace, or for a component that keeps none.
+  StageScratch* stageScratch(Workspace& ws) const {
+    return modelIndex_ >= 0 && modelIndex_ < static_cast<int>(ws.stageScratch.size())
+               ? ws.stageScratch[modelIndex_].get()
+               : nullptr;
+  }
 
  private:
+  friend class Model;
   std::string name_;
   std::vector<int> dofs_;
+  int modelIndex_ = -1;  // position in the model's components, set by the model
 };
 
 }  // namespace mpx

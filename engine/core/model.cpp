@@ -20,6 +20,7 @@ Model::Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::un
   // couplings read what the others publish: evaluate them last
   std::stable_partition(components_.begin(), components_.end(),
                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); });
+  for (std::size_t i = 0; i < components_.size(); ++i) components_[i]->modelIndex_ = static_cast<int>(i);
 }
 
 void Model::measure(const Eigen::VectorXd& z, Measures& out) const {
@@ -33,6 +34,7 @@ void Model::measure(const Eigen::VectorXd& z, Measures& out) const {
 Workspace Model::makeWorkspace() const {
   Workspace ws;
   ws.nodes.resize(thermalNodeNames_.size());
+  for (const auto& component : components_) ws.stageScratch.push_back(component->makeStageScratch());
   return ws;
 }
 

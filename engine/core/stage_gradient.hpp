@@ -50,48 +50,70 @@ inline FlooredNorm flooredNorm(double norm) {
   return {norm + kStagePathFloor * floorRatio, 1.0 - floorRatio * floorRatio};
 }
 
-// D psi at stage `stage` and its derivative with respect to stage path.column's values; f maps
-// a Vec3 to a Jet, `mask` selects the active arguments.
-template <class Fn>
-GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, const CollocationRule& rule,
-                                const StagePath& path, int stage) {
-  const int n = static_cast<int>(path.endRows[0].size()), s = rule.stages, k = path.column;
+// What D psi needs of psi along a path for every stage and column: the metric G, psi's jets at
+// the stages and the end, and mu = defect / floored norm with the floor's slope.
+struct StageJets {
   Vec3 metric = Vec3::Zero();
+  Jet end;
+  Jet stage[CollocationRule::kMostStages];
+  double defect = 0.0, norm = 1.0, normSlope = 1.0, mu = 0.0;
+};
+
+// psi's stage jets along `path`; f maps a Vec3 to a Jet, `mask` selects the active arguments.
+template <class Fn>
+StageJets stageJets(const Fn& f, unsigned mask, const Vec3& scale, const CollocationRule& rule, const StagePath& path) {
+  StageJets jets;
   for (int i = 0; i < 3; ++i)
-    if (mask >> i & 1u) metric[i] = 1.0 / (scale[i] * scale[i]);
+    if (mask >> i & 1u) jets.metric[i] = 1.0 / (scale[i] * scale[i]);
+  jets.end = f(path.end);
+  double defect = jets.end.value - f(path.start).value, norm = 0.0;
+  for (int j = 0; j < rule.stages; ++j) {
+    jets.stage[j] = f(path.value[j]);
+    defect -= rule.weight[j] * jets.stage[j].grad.dot(path.rate[j]);
+    norm += rule.weight[j] * path.rate[j].dot(jets.metric.cwiseProduct(path.rate[j]));
+  }
+  const FlooredNorm floored = flooredNorm(norm);
+  jets.defect = defect;
+  jets.norm = floored.value;
+  jets.normSlope = floored.slope;
+  jets.mu = defect / floored.value;
+  return jets;
+}
+
+// D psi at stage `stage` from psi's stage jets, and its derivative with respect to stage
+// path.column's values.
+inline GradientRows consistentGradient(const StageJets& jets, const CollocationRule& rule, const StagePath& path,
+                                       int stage) {
+  const int n = static_cast<int>(path.endRows[0].size()), s = rule.stages, k = path.column;
   auto alongRows = [&](const Vec3& coefficients, const LocalRow(&rows)[3]) -> LocalRow {
     return coefficients[0] * rows[0] + coefficients[1] * rows[1] + coefficients[2] * rows[2];
   };
-
-  Jet jet[CollocationRule::kMostStages];
-  const Jet endJet = f(path.end);
-  double defect = endJet.value - f(path.start).value, norm = 0.0;
-  for (int j = 0; j < s; ++j) {
-    jet[j] = f(path.value[j]);
-    defect -= rule.weight[j] * jet[j].grad.dot(path.rate[j]);
-    norm += rule.weight[j] * path.rate[j].dot(metric.cwiseProduct(path.rate[j]));
-  }
+  const Vec3& metric = jets.metric;
   GradientRows out;
-  out.grad = jet[stage].grad;
+  out.grad = jets.stage[stage].grad;
   for (int i = 0; i < 3; ++i)
-    out.d[i] = stage == k ? alongRows(jet[stage].hess.row(i).transpose(), path.rows[stage]) : LocalRow::Zero(n);
-  // mu and its derivative, from those of the defect and of the floored norm
-  const FlooredNorm floored = flooredNorm(norm);
-  const double dFlooredDNorm = floored.slope;
-  norm = floored.value;
-  const double mu = defect / norm;
-  LocalRow dDefect = rule.end[k + 1] * alongRows(endJet.grad, path.endRows);
+    out.d[i] = stage == k ? alongRows(jets.stage[stage].hess.row(i).transpose(), path.rows[stage]) : LocalRow::Zero(n);
+  // mu's derivative, from those of the defect and of the floored norm
+  const double mu = jets.mu;
+  LocalRow dDefect = rule.end[k + 1] * alongRows(jets.end.grad, path.endRows);
   LocalRow dNorm = LocalRow::Zero(n);
   for (int j = 0; j < s; ++j) {
-    if (j == k) dDefect -= rule.weight[j] * alongRows(jet[j].hess * path.rate[j], path.rows[j]);
-    dDefect -= rule.weight[j] * alongRows(jet[j].grad, path.rateRows[j]);
+    if (j == k) dDefect -= rule.weight[j] * alongRows(jets.stage[j].hess * path.rate[j], path.rows[j]);
+    dDefect -= rule.weight[j] * alongRows(jets.stage[j].grad, path.rateRows[j]);
     dNorm += (2.0 * rule.weight[j]) * alongRows(metric.cwiseProduct(path.rate[j]), path.rateRows[j]);
   }
-  const LocalRow dMu = (dDefect - (mu * dFlooredDNorm) * dNorm) / norm;
+  const LocalRow dMu = (dDefect - (mu * jets.normSlope) * dNorm) / jets.norm;
   const Vec3 direction = metric.cwiseProduct(path.rate[stage]);
   out.grad += mu * direction;
   for (int i = 0; i < 3; ++i) out.d[i] += direction[i] * dMu + (mu * metric[i]) * path.rateRows[stage][i];
   return out;
+}
+
+// The same from psi itself: f maps a Vec3 to a Jet, `mask` selects the active arguments.
+template <class Fn>
+GradientRows consistentGradient(const Fn& f, unsigned mask, const Vec3& scale, const CollocationRule& rule,
+                                const StagePath& path, int stage) {
+  return consistentGradient(stageJets(f, mask, scale, rule, path), rule, path, stage);
 }
 
 }  // namespace mpx

@@ -176,6 +176,8 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
   for (args.stage = 0; args.stage < stages_; ++args.stage)
     for (int offset = 0; offset < columnPasses; ++offset) {
       args.column = (args.stage + offset) % stages_;
+      // every pass after the first meets each component at the stage values it has seen
+      args.samePath = args.stage > 0 || offset > 0;
       add(model, ws,
           {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent}, evaluate,
           args.tangent ? everyComponent_ : stageByStage_);

@@ -185,10 +185,9 @@ void LumpedElement::rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& 
   }
 }
 
-StagePath LumpedElement::stagePath(const StageArgs& args) const {
+void LumpedElement::fillStageData(const StageArgs& args, StageData& data) const {
   const CollocationRule& rule = *args.rule;
-  StagePath path;
-  path.column = args.column;
+  StagePath& path = data.path;
   const Vec3 separationEnd = separation(args.zEnd);
   path.start = arguments(args.zOld, separation(args.zOld));
   path.end = arguments(args.zEnd, separationEnd);
@@ -196,34 +195,59 @@ StagePath LumpedElement::stagePath(const StageArgs& args) const {
   for (int j = 0; j < rule.stages; ++j) {
     const double* z = args.stageState[j];
     const double* zdot = args.stageRate[j];
-    const Vec3 separation = this->separation(z);
-    const Vec3 separationRate = geometry_ ? geometry_->separationRate(zdot) : Vec3::Zero();
+    const Vec3& separation = data.separation[j] = this->separation(z);
+    const Vec3& separationRate = data.separationRate[j] = geometry_ ? geometry_->separationRate(zdot) : Vec3::Zero();
     path.value[j] = arguments(z, separation);
     // tau-rates a' = dt (2 d . d', s', gamma')
     path.rate[j] =
         args.dt * Vec3(2.0 * separation.dot(separationRate), localThermal_ >= 0 ? zdot[spec_.thermalDof] : 0.0,
                        localInternal_ >= 0 ? zdot[spec_.internalDof] : 0.0);
     argumentRows(separation, path.rows[j], args.tangent);
-    // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
-    // on its own stage's separation as well (rows for a tangent only)
-    if (!args.tangent) continue;
+  }
+  auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
+  auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
+  data.energy = stageJets(energy, mask_, spec_.argumentScale, rule, path);
+  if (linearEntropy_)
+    data.entropy.end = entropy(path.end);
+  else
+    data.entropy = stageJets(entropy, mask_, spec_.argumentScale, rule, path);
+}
+
+void LumpedElement::columnRows(const StageArgs& args, StageData& data) const {
+  const CollocationRule& rule = *args.rule;
+  StagePath& path = data.path;
+  path.column = args.column;
+  // a'_j depends on stage k's values through the rates (coefficient rule.rate) and, for c,
+  // on its own stage's separation as well (rows as empty as path.rows without a tangent)
+  for (int j = 0; j < rule.stages; ++j) {
     const double rateCoefficient = rule.rate[j][args.column + 1];
     for (int i = 0; i < 3; ++i) path.rateRows[j][i] = rateCoefficient * path.rows[j][i];
-    if (geometry_ && j == args.column) geometry_->addSeparationRow(path.rateRows[j][0], 2.0 * args.dt * separationRate);
+    if (args.tangent && geometry_ && j == args.column)
+      geometry_->addSeparationRow(path.rateRows[j][0], 2.0 * args.dt * data.separationRate[j]);
   }
-  return path;
 }
 
 void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const {
+  // the path and the jets once per evaluation where the workspace keeps them between passes
+  if (auto* kept = static_cast<StageData*>(stageScratch(ws))) {
+    if (!args.samePath) fillStageData(args, *kept);
+    stageBalances(args, *kept, ws, out, flows);
+    return;
+  }
+  StageData own;
+  fillStageData(args, own);
+  stageBalances(args, own, ws, out, flows);
+}
+
+void LumpedElement::stageBalances(const StageArgs& args, StageData& data, Workspace& ws, LocalSystem& out,
+                                  Flows& flows) const {
   const int l = args.stage;
-  const StagePath path = stagePath(args);
-  auto energy = [&](const Vec3& x) { return spec_.law->energy(x); };
-  auto entropy = [&](const Vec3& x) { return spec_.law->entropy(x); };
-  const GradientRows dEnergy = consistentGradient(energy, mask_, spec_.argumentScale, *args.rule, path, l);
+  columnRows(args, data);
+  const StagePath& path = data.path;
+  const GradientRows dEnergy = consistentGradient(data.energy, *args.rule, path, l);
   // a linear entropy's stage gradient is its gradient (zero Hessian: zero rows)
-  const GradientRows dEntropy = linearEntropy_
-                                    ? alongRows(exactGradient(entropy(path.end)), path.endRows)
-                                    : consistentGradient(entropy, mask_, spec_.argumentScale, *args.rule, path, l);
+  const GradientRows dEntropy = linearEntropy_ ? alongRows(exactGradient(data.entropy.end), path.endRows)
+                                               : consistentGradient(data.entropy, *args.rule, path, l);
   Response response = respond(dEnergy, dEntropy);
   // at steps far too long for the motion the stage temperature can leave (0, inf): that is no
   // solution (its heat would lower the entropy), so the residual is made non-finite and Newton
@@ -235,8 +259,7 @@ void LumpedElement::stageLocal(const StageArgs& args, Workspace& ws, LocalSystem
   const Vec3& rate = path.rate[l];
   const double gammaRate = rate[2] / args.dt;
   const double entropyRate = dEntropy.grad.dot(rate) / args.dt;
-  const Vec3 separation = this->separation(args.stageState[l]);
-  addBalances(response, 1.0, 2.0 * separation, gammaRate, entropyRate, ws, out, flows);
+  addBalances(response, 1.0, 2.0 * data.separation[l], gammaRate, entropyRate, ws, out, flows);
   if (!args.tangent) return;
 
   // explicit dependence: the force direction 2 d_l on its own stage, gamma' and the entropy rate

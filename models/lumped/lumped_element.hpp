@@ -50,6 +50,7 @@ class LumpedElement final : public Component {
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   StageForm stageForm() const override { return StageForm::Own; }
   void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  std::unique_ptr<StageScratch> makeStageScratch() const override { return std::make_unique<StageData>(); }
 
  private:
   // Conjugate quantities and their derivatives over the local dofs.
@@ -69,8 +70,21 @@ class LumpedElement final : public Component {
   static LocalRow chain(const Vec3& dArguments, const LocalRow (&rows)[3]);
   // A discrete gradient's derivative with respect to b, carried onto the local dofs.
   static GradientRows alongRows(const DiscreteGradient& gradient, const LocalRow (&rows)[3]);
-  // The arguments along an eem4 step's stage polynomial, for the tangent block args.column.
-  StagePath stagePath(const StageArgs& args) const;
+  // What an eem4 evaluation's passes share: the arguments along the stage polynomial (the
+  // rows for the tangent's column are rewritten at each call), the separations and their rates
+  // at the stages, and the law's jets along the path (the entropy's only at the end when it is
+  // linear).
+  struct StageData final : StageScratch {
+    StagePath path;
+    Vec3 separation[CollocationRule::kMostStages], separationRate[CollocationRule::kMostStages];
+    StageJets energy, entropy;
+  };
+  // Fill what does not depend on the stage or the tangent's column.
+  void fillStageData(const StageArgs& args, StageData& data) const;
+  // The rows of the tangent's column args.column: da'_j/dZ_column.
+  void columnRows(const StageArgs& args, StageData& data) const;
+  // stageLocal from the evaluation's stage data.
+  void stageBalances(const StageArgs& args, StageData& data, Workspace& ws, LocalSystem& out, Flows& flows) const;
   // Residual rows shared by all forms and the tangent terms through the response's
   // derivatives (times zCoefficient): momentum f (2 d), internal nu gammaRate - g, thermal
   // theta entropyRate - g^2/nu; also publishes the node temperature.
