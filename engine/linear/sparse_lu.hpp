@@ -23,7 +23,8 @@ class SparseLu {
 };
 
 // Systems of at least this many unknowns go to UMFPACK. Of at most kSmallSystem to a dense LU;
-// a caller whose factorisations each serve many solves (IDA) takes it up to kManySolvesSystem.
+// a caller whose factorisations each serve many solves (IDA, simplified Newton) takes it up to
+// kManySolvesSystem.
 inline constexpr int kLargeSystem = 3000;
 inline constexpr int kSmallSystem = 32;
 inline constexpr int kManySolvesSystem = 200;
