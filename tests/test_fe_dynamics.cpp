@@ -632,8 +632,8 @@ TEST_P(CondensedNewton, AgreesWithAPlainSparseLu) {
     VectorXd again(unknowns.size());
     condensed.solve(residual, again);
     EXPECT_EQ((again - increment).lpNorm<Eigen::Infinity>(), 0.0);
-    // (eem4's residual alone sums each solid cell's stages after the other components, in
-    // another order: the same to round-off)
+    // (eem4's residual alone sums the stages of each solid cell and constraint after the other
+    // components, in another order: the same to round-off)
     integrator.evaluate(zOld, unknowns, 2.0, 0.1, false);
     const double roundOff = stages > 1 ? 1e-14 : 0.0;
     EXPECT_LE((system.residual() - residual).lpNorm<Eigen::Infinity>(), roundOff * residual.lpNorm<Eigen::Infinity>());

@@ -122,14 +122,18 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
 }
 
 void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSystem& out, Flows&) const {
+  addStages(args, args.stage, 1, &out);
+}
+
+void QuadraticConstraint::stageResiduals(const StageArgs& args, Workspace&, LocalSystem* out, Flows*) const {
+  addStages(args, 0, args.rule->stages, out);
+}
+
+void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const {
   const CollocationRule& rule = *args.rule;
-  const int l = args.stage, column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
-  const bool own = l == column;
-  auto r = out.residual();
-  auto K = out.tangent();
-  const double* z = args.stageState[l];
+  const int column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
   // the basis points of the step's polynomial (the start, then each stage), and the positions
-  // and their tau-rates at the points of the fine rule, which every form shares
+  // and their tau-rates at the points of the fine rule, which every form and stage share
   ConstraintVector basis[CollocationRule::kMostStages + 1];
   basis[0] = gather(args.zOld, 0);
   for (int j = 0; j < rule.stages; ++j) basis[j + 1] = gather(args.stageState[j], 0);
@@ -148,58 +152,74 @@ void QuadraticConstraint::stageLocal(const StageArgs& args, Workspace&, LocalSys
     double lambda[CollocationRule::kMostStages] = {};
     if (held)
       for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
-    // Galerkin projections onto stage l's test function, exact for these polynomial integrands:
-    // the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
-    ConstraintVector force = ConstraintVector::Zero(n), dForceDLambda = ConstraintVector::Zero(n),
-                     rateRow = ConstraintVector::Zero(n);
-    // (the n x n block only where a tangent is wanted: residual-only passes are most of them)
+    // Galerkin projections onto each stage's test function, exact for these polynomial
+    // integrands: the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
+    ConstraintVector force[CollocationRule::kMostStages];
+    double rateOfPhi[CollocationRule::kMostStages] = {};
+    for (int i = 0; i < count; ++i) force[i] = ConstraintVector::Zero(n);
+    // the tangent (one stage at a time): the n x n block, the Hessian's share of it summed over
+    // the points before it multiplies H, lambda's column and row
     ConstraintMatrix dForce;
-    if (args.tangent) dForce.setZero(n, n);
-    // the Hessian's share of dForce, summed over the points before it multiplies H
-    double hessianWeight = 0.0, rateOfPhi = 0.0;
+    ConstraintVector dForceDLambda, rateRow;
+    double hessianWeight = 0.0;
+    if (args.tangent) {
+      dForce.setZero(n, n);
+      dForceDLambda = rateRow = ConstraintVector::Zero(n);
+    }
     for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
       const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
       const ConstraintVector gradient = form.gradientAt(q);
       const double phi = form.valueAt(q, gradient);
-      const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
-      const double value = multiplier + spec_.stiffness * phi, valueCoefficient = rule.fineValue[p][column + 1];
-      force += (test * value) * gradient;
-      if (held) rateOfPhi += test * gradient.dot(rate);
-      if (!args.tangent) continue;
-      hessianWeight += test * valueCoefficient * value;
-      dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
-      if (!held) continue;
-      dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-      rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
+      const double value = multiplier + spec_.stiffness * phi;
+      for (int i = 0; i < count; ++i) {
+        const int l = firstStage + i;
+        const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
+        force[i] += (test * value) * gradient;
+        if (held) rateOfPhi[i] += test * gradient.dot(rate);
+        if (!args.tangent) continue;
+        const double valueCoefficient = rule.fineValue[p][column + 1];
+        hessianWeight += test * valueCoefficient * value;
+        dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
+        if (!held) continue;
+        dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
+        rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
+      }
     }
-    r.segment(n, n) += force;
-    if (args.tangent) {
-      K.block(n, 0, n, n) += dForce;
-      form.addHessian(hessianWeight, K.block(n, 0, n, n));
-    }
-    if (!augmented()) continue;
-    // mu is not used (mu = 0), nor lambda of an implied form
-    const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
-    r[mu] = z[spec_.firstMultiplierDof + m + k];
-    if (own) K(mu, mu) = 1.0;
-    if (!held) {
-      r[lambdaRow] = z[spec_.firstMultiplierDof + k];
-      if (own) K(lambdaRow, lambdaRow) = 1.0;
-      continue;
-    }
-    K.block(n, lambdaRow, n, 1) += dForceDLambda;
-    // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
-    // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
-    // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
-    if (l == 0) {
-      const ConstraintVector gradientEnd = form.gradientAt(qEnd);
-      r[lambdaRow] = form.valueAt(qEnd, gradientEnd);
-      K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * gradientEnd.transpose();
-    } else {
-      r[lambdaRow] = rateOfPhi / args.dt;
-      K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;
+    for (int i = 0; i < count; ++i) {
+      const int l = firstStage + i;
+      const bool own = args.tangent && l == column;
+      const double* z = args.stageState[l];
+      auto r = out[i].residual();
+      auto K = out[i].tangent();
+      r.segment(n, n) += force[i];
+      if (args.tangent) {
+        K.block(n, 0, n, n) += dForce;
+        form.addHessian(hessianWeight, K.block(n, 0, n, n));
+      }
+      if (!augmented()) continue;
+      // mu is not used (mu = 0), nor lambda of an implied form
+      const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
+      r[mu] = z[spec_.firstMultiplierDof + m + k];
+      if (own) K(mu, mu) = 1.0;
+      if (!held) {
+        r[lambdaRow] = z[spec_.firstMultiplierDof + k];
+        if (own) K(lambdaRow, lambdaRow) = 1.0;
+        continue;
+      }
+      if (args.tangent) K.block(n, lambdaRow, n, 1) += dForceDLambda;
+      // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
+      // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
+      // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
+      if (l == 0) {
+        const ConstraintVector gradientEnd = form.gradientAt(qEnd);
+        r[lambdaRow] = form.valueAt(qEnd, gradientEnd);
+        if (args.tangent) K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * gradientEnd.transpose();
+      } else {
+        r[lambdaRow] = rateOfPhi[i] / args.dt;
+        if (args.tangent) K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;
+      }
     }
   }
 }

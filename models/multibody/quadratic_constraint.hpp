@@ -60,6 +60,9 @@ class QuadraticConstraint final : public Component {
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   StageForm stageForm() const override { return StageForm::Own; }
   void stageLocal(const StageArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
+  // a residual-only evaluation takes the positions along the path once for all stages
+  bool evaluatesStagesTogether() const override { return true; }
+  void stageResiduals(const StageArgs& args, Workspace& ws, LocalSystem* out, Flows* flows) const override;
 
  private:
   static std::vector<int> collectDofs(const ConstraintSpec& spec);
@@ -68,6 +71,9 @@ class QuadraticConstraint final : public Component {
   // lambda_k (0 for penalty).
   double multiplier(const double* z, std::size_t k) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
+  // The stage form for stages firstStage .. firstStage + count - 1 into out[0 .. count - 1]: the
+  // residuals, and with args.tangent (count 1) the derivative w.r.t. stage args.column.
+  void addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const;
   ConstraintSpec spec_;
   int positionCount_;
   std::vector<bool> implied_;  // per form: multipliers held at zero
