@@ -50,8 +50,11 @@ class JointForce final : public Component {
  public:
   explicit JointForce(JointForceSpec spec);
 
-  // local order q, v, heat, internal: writes every row but the kinematic ones
-  bool couples(int row, int, LocalForm) const override { return row >= static_cast<int>(spec_.positionDofs.size()); }
+  // local order q, v, heat, internal: every row but the kinematic ones, of the coordinates the
+  // invariants touch and of heat and gamma, against the same columns
+  bool couples(int row, int column, LocalForm) const override {
+    return row >= n_ && reachedByInvariants(row) && reachedByInvariants(column);
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -62,6 +65,13 @@ class JointForce final : public Component {
 
  private:
   static std::vector<int> collectDofs(const JointForceSpec& spec);
+  // False for the position or velocity of a coordinate no invariant touches.
+  bool reachedByInvariants(int local) const {
+    if (local >= 2 * n_) return true;
+    for (const QuadraticForm& invariant : spec_.invariants)
+      if (invariant.touches(local % n_)) return true;
+    return false;
+  }
   ConstraintVector gather(const double* z, int shift) const;
   // (I_0, I_1, gamma) of a state; unused slots are 0.
   Vec3 arguments(const double* z) const;

@@ -1,6 +1,7 @@
 #include "models/multibody/quadratic_constraint.hpp"
 
 #include <cmath>
+#include <utility>
 
 namespace mpx {
 
@@ -24,6 +25,40 @@ ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
   ConstraintVector q(positionCount_);
   for (int i = 0; i < positionCount_; ++i) q[i] = z[spec_.positionDofs[i] + shift];
   return q;
+}
+
+// A form's terms reach the coordinates it touches: the momentum rows of those coordinates get
+// (lambda + kappa Phi) grad Phi and its Hessian, lambda's row Phi or its rate; mu's row is mu = 0
+// outside the rate form, where it is G v = 0 and mu grad Phi enters the kinematic rows.
+bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
+  const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  enum class Kind { Position, Velocity, Lambda, Mu };
+  auto split = [&](int local) -> std::pair<Kind, int> {
+    if (local < n) return {Kind::Position, local};
+    if (local < 2 * n) return {Kind::Velocity, local - n};
+    return local < 2 * n + m ? std::pair{Kind::Lambda, local - 2 * n} : std::pair{Kind::Mu, local - 2 * n - m};
+  };
+  const auto [rowKind, r] = split(row);
+  const auto [columnKind, c] = split(column);
+  auto touches = [&](int k, int coordinate) { return spec_.forms[k].touches(coordinate); };
+  auto shareAForm = [&](int a, int b) {
+    for (int k = 0; k < m; ++k)
+      if (touches(k, a) && touches(k, b)) return true;
+    return false;
+  };
+  const bool rate = form == LocalForm::Rate;
+  switch (rowKind) {
+    case Kind::Velocity:
+      return (columnKind == Kind::Position && shareAForm(r, c)) || (columnKind == Kind::Lambda && touches(c, r));
+    case Kind::Position:
+      return rate && ((columnKind == Kind::Position && shareAForm(r, c)) || (columnKind == Kind::Mu && touches(c, r)));
+    case Kind::Lambda:
+      return (columnKind == Kind::Position && touches(r, c)) || (columnKind == Kind::Lambda && c == r);
+    case Kind::Mu:
+      return (columnKind == Kind::Mu && c == r) ||
+             (rate && (columnKind == Kind::Position || columnKind == Kind::Velocity) && touches(r, c));
+  }
+  return false;
 }
 
 double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {

@@ -38,13 +38,9 @@ class QuadraticConstraint final : public Component {
  public:
   explicit QuadraticConstraint(ConstraintSpec spec);
 
-  // only GGL's kinematic rows (the rate form) see the positions and mu; the step and stage
-  // forms leave the kinematic rows alone (local order: q, v, lambda, mu)
-  bool couples(int row, int column, LocalForm form) const override {
-    const int mus = 2 * positionCount_ + static_cast<int>(spec_.forms.size());
-    if (form != LocalForm::Rate) return row >= positionCount_;
-    return row >= positionCount_ || column < positionCount_ || column >= mus;
-  }
+  // The pairs the forms' coordinates reach (local order: q, v, lambda, mu): only GGL's rows (the
+  // rate form) write kinematic rows and read velocities.
+  bool couples(int row, int column, LocalForm form) const override;
   const ConstraintSpec& spec() const { return spec_; }
   // Form k is implied by other forms (a redundant condition, e.g. the out-of-plane conditions
   // of a planar loop of revolute joints): its multipliers are held at zero and its rows drop

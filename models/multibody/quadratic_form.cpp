@@ -7,6 +7,9 @@ QuadraticForm::QuadraticForm(const ConstraintMatrix& hessian, ConstraintVector g
   for (int column = 0; column < hessian.cols(); ++column)
     for (int row = 0; row < hessian.rows(); ++row)
       if (hessian(row, column) != 0.0) entries_.push_back({row, column, hessian(row, column)});
+  for (const Entry& e : entries_) support_ |= 1u << e.row;
+  for (int i = 0; i < gradient_.size(); ++i)
+    if (gradient_[i] != 0.0) support_ |= 1u << i;
 }
 
 ConstraintVector QuadraticForm::hessianTimes(const ConstraintVector& v) const {

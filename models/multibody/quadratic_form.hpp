@@ -6,12 +6,13 @@
 // product goes through them.
 #include <Eigen/Dense>
 
+#include <cstdint>
 #include <vector>
 
 namespace mpx {
 
 // Largest number of position dofs one constraint set couples (two rigid bodies).
-inline constexpr int kMaxConstrainedDofs = 24;
+inline constexpr int kMaxConstrainedDofs = 24;  // at most 32: a form's support is a bit mask
 using ConstraintVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstrainedDofs, 1>;
 using ConstraintMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
@@ -31,6 +32,8 @@ class QuadraticForm {
     return 0.5 * q.dot(gradientAtQ + gradient_) + constant_;
   }
   double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
+  // Whether phi depends on coordinate i (its gradient's entry i can be non-zero).
+  bool touches(int i) const { return support_ >> i & 1u; }
   // K += factor H, for K (an expression of) the n x n block of the coordinates
   template <class Block>
   void addHessian(double factor, Block&& K) const {
@@ -45,6 +48,7 @@ class QuadraticForm {
   std::vector<Entry> entries_;  // H's nonzeros, by column
   ConstraintVector gradient_;
   double constant_;
+  std::uint32_t support_ = 0;  // bit i: H's row i or g_i is non-zero
 };
 
 }  // namespace mpx
