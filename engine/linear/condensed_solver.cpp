@@ -8,8 +8,8 @@ namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 }  // namespace
 
-CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern, bool symmetricPart, int denseUpTo)
-    : factorizedTangent_(pattern), symmetricPart_(symmetricPart), denseUpTo_(denseUpTo) {
+CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& pattern, bool symmetricPart)
+    : factorizedTangent_(pattern), symmetricPart_(symmetricPart) {
   // positions come first in the layout, velocities right after, dof for dof; a collocation
   // step's system (eem4) repeats the layout once per stage, and each stage's kinematic rows
   // pair with its own velocities in the same way
@@ -31,7 +31,7 @@ CondensedSolver::CondensedSolver(const Layout& layout, const SparseMatrix& patte
   internal_.build(stage, internalRanges);
   internalRhs_.resize(internal_.active() ? internal_.reduced().rows() : 0);
   internalSolution_.resize(stage.rows());
-  lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_, denseUpTo_);
+  lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_);
 }
 
 void CondensedSolver::numberUnknowns(int n, int positions, int stages) {

@@ -28,10 +28,8 @@ class CondensedSolver {
  public:
   // `pattern`: the fixed pattern of every tangent this solver will see. `symmetricPart`: a large
   // condensed system is factorised by its symmetric part (an approximation, for simplified
-  // Newton only; engine/linear/cholmod_solver.hpp). `denseUpTo`: the largest condensed system
-  // factorised by a dense LU (engine/linear/sparse_lu.hpp).
-  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern, bool symmetricPart = false,
-                  int denseUpTo = kSmallSystem);
+  // Newton only; engine/linear/cholmod_solver.hpp).
+  CondensedSolver(const Layout& layout, const Eigen::SparseMatrix<double>& pattern, bool symmetricPart = false);
 
   // Factorise the condensed form of `tangent` (of the pattern given at construction). Its values
   // are kept, since solve reads its kinematic rows and velocity couplings: the tangent may be
@@ -39,7 +37,7 @@ class CondensedSolver {
   // Returns false if singular.
   bool factorize(const Eigen::SparseMatrix<double>& tangent, bool repivot);
   // Forget the factorisation, its pivots and analysis: the next factorize starts as the first.
-  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_, denseUpTo_); }
+  void startAfresh() { lu_ = makeSparseLu(static_cast<int>(factorised().rows()), symmetricPart_); }
   // increment = -K^{-1} residual for the last factorised K. Allocates nothing.
   void solve(const Eigen::VectorXd& residual, Eigen::VectorXd& increment);
   // Whether the last factorisation is of the (condensed) tangent itself, not an approximation.
@@ -109,7 +107,6 @@ class CondensedSolver {
   GroupElimination internal_;
   Eigen::VectorXd internalRhs_, internalSolution_;  // of the system after velocity condensation
   bool symmetricPart_;
-  int denseUpTo_;
   std::unique_ptr<SparseLu> lu_;
 };
 

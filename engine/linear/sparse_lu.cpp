@@ -7,10 +7,10 @@
 
 namespace mpx {
 
-std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart, int denseUpTo) {
+std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart) {
   if (size >= kLargeSystem && symmetricPart) return std::make_unique<CholmodSolver>(size);
   if (size >= kLargeSystem) return std::make_unique<UmfpackSolver>(size);
-  if (size <= denseUpTo) return std::make_unique<DenseLu>(size);
+  if (size <= kSmallSystem) return std::make_unique<DenseLu>(size);
   return std::make_unique<KluSolver>();
 }
 

@@ -22,22 +22,17 @@ class SparseLu {
   virtual bool approximates() const { return false; }
 };
 
-// Systems of at least this many unknowns go to UMFPACK. Of at most kSmallSystem to a dense LU;
-// a caller whose factorisations each serve many solves (IDA, simplified Newton) takes it up to
-// kManySolvesSystem.
+// Systems of at least this many unknowns go to UMFPACK, of at most kSmallSystem to a dense LU.
 inline constexpr int kLargeSystem = 3000;
 inline constexpr int kSmallSystem = 32;
-inline constexpr int kManySolvesSystem = 200;
 
-// A dense LU for systems of up to `denseUpTo` unknowns (docs/performance.md: for the one-step
-// schemes' Newton, which factorises about once per step or more, 5-7 % less per step than KLU at
-// 7-16 unknowns and 20-25 % more at 106-158 multibody unknowns; for IDA, whose factorisations serve
-// tens of solves each, 12-33 % less per run at 69-158; for simplified Newton, 15 % less per EEM
-// step at the flyball governor's 158, but 20-25 % more at the L-block's 270, where KLU's factors
-// keep a quarter of the dense entries); KLU (pivot reuse, no allocation) for small systems such
-// as multibody and thermal networks; UMFPACK with a fill-reducing ordering for the large systems
-// of 3D solids, where KLU is 20-60 times slower. With `symmetricPart`, a large system gets
-// CHOLMOD on its symmetric part, an approximation for simplified Newton (cholmod_solver.hpp).
-std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false, int denseUpTo = kSmallSystem);
+// A dense LU for systems of up to kSmallSystem unknowns (docs/performance.md: 5-7 % less per
+// step than KLU at 7-16 unknowns; KLU is cheaper at the 64-190 unknowns of the multibody scenes
+// once their patterns hold only the entries their forms reach, for full and simplified Newton
+// and mostly for IDA); KLU (pivot reuse, no allocation) for small systems such as multibody and
+// thermal networks; UMFPACK with a fill-reducing ordering for the large systems of 3D solids,
+// where KLU is 20-60 times slower. With `symmetricPart`, a large system gets CHOLMOD on its
+// symmetric part, an approximation for simplified Newton (cholmod_solver.hpp).
+std::unique_ptr<SparseLu> makeSparseLu(int size, bool symmetricPart = false);
 
 }  // namespace mpx

@@ -81,8 +81,7 @@ int release(SUNLinearSolver solver) {
 SUNLinearSolver makeIdaLinearSolver(const Model& model, const Eigen::SparseMatrix<double>& pattern, void* ida,
                                     bool corotate, SUNContext context) {
   SUNLinearSolver solver = SUNLinSolNewEmpty(context);
-  // IDA keeps a Newton matrix for many steps: its solves, not its factorisations, dominate
-  auto* c = new Content{CondensedSolver(model.layout(), pattern, false, kManySolvesSystem),
+  auto* c = new Content{CondensedSolver(model.layout(), pattern),
                         pattern,
                         Eigen::VectorXd(pattern.rows()),
                         Eigen::VectorXd(pattern.rows()),

@@ -1,7 +1,7 @@
 #pragma once
 // A SUNDIALS linear solver over Metriplex's own condensed sparse solver (engine/linear/
-// condensed_solver.hpp: velocities eliminated through the kinematic rows, then a dense LU up to
-// kManySolvesSystem unknowns, KLU or UMFPACK),
+// condensed_solver.hpp: velocities eliminated through the kinematic rows, then a dense LU, KLU
+// or UMFPACK by size),
 // so that IDA factorises its Newton matrix as the one-step integrators do: half the unknowns for
 // mechanics, and UMFPACK with METIS for 3D solids, where SUNDIALS' KLU is 20-60 times slower
 // (docs/performance.md).

@@ -63,10 +63,7 @@ Integrator::Integrator(const Model& model, Scheme scheme, NewtonSettings setting
       settings_(settings),
       rule_(gaussCollocation(scheme == Scheme::Eem4 ? 2 : 1)),
       assembler_(model, localForm(scheme), rule_.stages),
-      // a factorisation simplified Newton keeps serves many solves, as IDA's do: dense up to
-      // the size where that pays (sparse_lu.hpp)
-      solver_(model.layout(), assembler_.tangent(), settings.symmetricFactorisation && rule_.stages == 1,
-              settings.reuseContraction > 0.0 ? kManySolvesSystem : kSmallSystem),
+      solver_(model.layout(), assembler_.tangent(), settings.symmetricFactorisation && rule_.stages == 1),
       corotation_(model, rule_.stages),
       turnedResidual_(rule_.stages * model.layout().total()),
       workspace_(model.makeWorkspace()),
