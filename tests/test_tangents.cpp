@@ -263,6 +263,31 @@ TEST_P(StepTangent, MatchesFiniteDifferencesAtOldState) {
   expectTangentMatchesAt(oldUnknowns_, 1e-7, GetParam().scheme == Scheme::Eem4 ? 1e-3 : kTolerance);
 }
 
+// The pattern holds only pairs a component writes: at a generic state every entry of the hinged
+// links' tangent (rigid bodies, a hinge by augmented Lagrangian, a ball joint by penalty) is
+// non-zero, in the step, stage and rate forms, but for a dof's own pair in each block of stages
+// (the assembler's diagonal, and eem4's held multipliers, written in their own stage only). A pair claimed beyond a
+// form's reach costs in every factorisation and solve (docs/performance.md, "Stage passes that
+// share their work; tangent patterns of the forms' reach").
+TEST(TangentPattern, HoldsOnlyPairsTheConstraintsWrite) {
+  const CompiledScene scene = compile(kScenes[6], ThermalVariable::Entropy, DiscreteGradientForm::Partitioned);
+  ASSERT_STREQ(kScenes[6].name, "hinged_links");
+  for (Scheme scheme : {Scheme::Eem, Scheme::Eem4, Scheme::Midpoint}) {
+    Integrator integrator(*scene.model, scheme, NewtonSettings{});
+    const VectorXd zOld = scene.model->initialState();
+    const VectorXd start = zOld.replicate(integrator.stageCount(), 1);
+    const VectorXd magnitude = start.cwiseAbs() + scene.model->dofScale().replicate(integrator.stageCount(), 1);
+    const Eigen::SparseMatrix<double>& K =
+        integrator.evaluate(zOld, start + 1e-2 * randomIsh(magnitude, 7), kTime, kTimeStep).tangent();
+    const int dofs = scene.model->layout().total();
+    int zeros = 0;
+    for (int column = 0; column < K.outerSize(); ++column)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, column); it; ++it)
+        if (it.row() % dofs != column % dofs && it.value() == 0.0) ++zeros;
+    EXPECT_EQ(zeros, 0) << schemeName(scheme) << ": zero entries of " << K.nonZeros();
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllElements, StepTangent, testing::ValuesIn(stepCases()),
                          [](const testing::TestParamInfo<StepCase>& info) {
                            const StepCase& c = info.param;

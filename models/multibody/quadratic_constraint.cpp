@@ -29,7 +29,8 @@ ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
 
 // A form's terms reach the coordinates it touches: the momentum rows of those coordinates get
 // (lambda + kappa Phi) grad Phi and its Hessian, lambda's row Phi or its rate; mu's row is mu = 0
-// outside the rate form, where it is G v = 0 and mu grad Phi enters the kinematic rows.
+// outside the rate form, where it is G v = 0 (the velocities it touches, the positions through
+// H v) and mu grad Phi enters the kinematic rows (mu's column, the positions through mu H).
 bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
   const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
   enum class Kind { Position, Velocity, Lambda, Mu };
@@ -46,17 +47,24 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
       if (touches(k, a) && touches(k, b)) return true;
     return false;
   };
+  auto shareAHessian = [&](int a, int b) {
+    for (int k = 0; k < m; ++k)
+      if (spec_.forms[k].hessianCouples(a, b)) return true;
+    return false;
+  };
   const bool rate = form == LocalForm::Rate;
   switch (rowKind) {
     case Kind::Velocity:
       return (columnKind == Kind::Position && shareAForm(r, c)) || (columnKind == Kind::Lambda && touches(c, r));
     case Kind::Position:
-      return rate && ((columnKind == Kind::Position && shareAForm(r, c)) || (columnKind == Kind::Mu && touches(c, r)));
+      return rate &&
+             ((columnKind == Kind::Position && shareAHessian(r, c)) || (columnKind == Kind::Mu && touches(c, r)));
     case Kind::Lambda:
       return (columnKind == Kind::Position && touches(r, c)) || (columnKind == Kind::Lambda && c == r);
     case Kind::Mu:
       return (columnKind == Kind::Mu && c == r) ||
-             (rate && (columnKind == Kind::Position || columnKind == Kind::Velocity) && touches(r, c));
+             (rate && ((columnKind == Kind::Position && spec_.forms[r].hessianCouples(c)) ||
+                       (columnKind == Kind::Velocity && touches(r, c))));
   }
   return false;
 }
