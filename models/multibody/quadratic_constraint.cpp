@@ -19,7 +19,13 @@ QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
     : Component(spec.name, collectDofs(spec)),
       spec_(std::move(spec)),
       positionCount_(static_cast<int>(spec_.positionDofs.size())),
-      implied_(spec_.forms.size(), false) {}
+      implied_(spec_.forms.size(), false) {
+  for (const QuadraticForm& form : spec_.forms)
+    for (int a = 0; a < positionCount_; ++a) {
+      if (form.touches(a)) sharesAForm_[a] |= form.support();
+      sharesAHessian_[a] |= form.hessianRow(a);
+    }
+}
 
 ConstraintVector QuadraticConstraint::gather(const double* z, int shift) const {
   ConstraintVector q(positionCount_);
@@ -42,16 +48,8 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
   const auto [rowKind, r] = split(row);
   const auto [columnKind, c] = split(column);
   auto touches = [&](int k, int coordinate) { return spec_.forms[k].touches(coordinate); };
-  auto shareAForm = [&](int a, int b) {
-    for (int k = 0; k < m; ++k)
-      if (touches(k, a) && touches(k, b)) return true;
-    return false;
-  };
-  auto shareAHessian = [&](int a, int b) {
-    for (int k = 0; k < m; ++k)
-      if (spec_.forms[k].hessianCouples(a, b)) return true;
-    return false;
-  };
+  auto shareAForm = [&](int a, int b) { return (sharesAForm_[a] >> b & 1u) != 0; };
+  auto shareAHessian = [&](int a, int b) { return (sharesAHessian_[a] >> b & 1u) != 0; };
   const bool rate = form == LocalForm::Rate;
   switch (rowKind) {
     case Kind::Velocity:
@@ -63,7 +61,7 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
       return (columnKind == Kind::Position && touches(r, c)) || (columnKind == Kind::Lambda && c == r);
     case Kind::Mu:
       return (columnKind == Kind::Mu && c == r) ||
-             (rate && ((columnKind == Kind::Position && spec_.forms[r].hessianCouples(c)) ||
+             (rate && ((columnKind == Kind::Position && spec_.forms[r].hessianRow(c) != 0) ||
                        (columnKind == Kind::Velocity && touches(r, c))));
   }
   return false;

@@ -73,6 +73,9 @@ class QuadraticConstraint final : public Component {
   ConstraintSpec spec_;
   int positionCount_;
   std::vector<bool> implied_;  // per form: multipliers held at zero
+  // per coordinate, as bit masks over the coordinates: those sharing a form with it, and those
+  // a form's Hessian couples to it
+  std::uint32_t sharesAForm_[kMaxConstrainedDofs] = {}, sharesAHessian_[kMaxConstrainedDofs] = {};
 };
 
 }  // namespace mpx

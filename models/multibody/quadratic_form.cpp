@@ -12,6 +12,13 @@ QuadraticForm::QuadraticForm(const ConstraintMatrix& hessian, ConstraintVector g
     if (gradient_[i] != 0.0) support_ |= 1u << i;
 }
 
+std::uint32_t QuadraticForm::hessianRow(int i) const {
+  std::uint32_t row = 0;
+  for (const Entry& e : entries_)
+    if (e.row == i) row |= 1u << e.column;
+  return row;
+}
+
 ConstraintVector QuadraticForm::hessianTimes(const ConstraintVector& v) const {
   ConstraintVector product = ConstraintVector::Zero(gradient_.size());
   for (const Entry& e : entries_) product[e.row] += e.value * v[e.column];

@@ -34,12 +34,9 @@ class QuadraticForm {
   double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
   // Whether phi depends on coordinate i (its gradient's entry i can be non-zero).
   bool touches(int i) const { return support_ >> i & 1u; }
-  // Whether H couples coordinates i and j (any j < 0: whether H has a row i).
-  bool hessianCouples(int i, int j = -1) const {
-    for (const Entry& e : entries_)
-      if (e.row == i && (j < 0 || e.column == j)) return true;
-    return false;
-  }
+  // The coordinates phi depends on, and those H couples to coordinate i, as bit masks.
+  std::uint32_t support() const { return support_; }
+  std::uint32_t hessianRow(int i) const;
   // K += factor H, for K (an expression of) the n x n block of the coordinates
   template <class Block>
   void addHessian(double factor, Block&& K) const {
