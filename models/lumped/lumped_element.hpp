@@ -43,8 +43,11 @@ class LumpedElement final : public Component {
  public:
   explicit LumpedElement(LumpedElementSpec spec);
 
-  // writes momentum, thermal and internal rows, never the end points' kinematic rows
-  bool couples(int row, int, LocalForm) const override { return !geometry_ || !geometry_->isPosition(row); }
+  // writes momentum, thermal and internal rows, never the end points' kinematic rows, and reads
+  // the separation's rate from the position rates, never the velocities
+  bool couples(int row, int column, LocalForm) const override {
+    return !geometry_ || (!geometry_->isPosition(row) && !geometry_->isVelocity(column));
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -122,4 +122,10 @@ bool TwoPointGeometry::isPosition(int local) const {
   return false;
 }
 
+bool TwoPointGeometry::isVelocity(int local) const {
+  for (const End& end : ends_)
+    if (end.point.moves() && local >= end.localVelocity && local < end.localVelocity + 3 * end.point.terms) return true;
+  return false;
+}
+
 }  // namespace mpx

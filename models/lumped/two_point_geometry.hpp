@@ -57,8 +57,10 @@ class TwoPointGeometry {
   void addSeparationVelocityTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDw) const;
   // Row over local dofs of d(w . d)/dz.
   void addSeparationRow(LocalRow& row, const Vec3& w) const;
-  // Whether local dof `local` is an end point's position (a row these elements never write).
+  // Whether local dof `local` is an end point's position (a row these elements never write), or
+  // its velocity.
   bool isPosition(int local) const;
+  bool isVelocity(int local) const;
 
  private:
   // An end point with the sign of its force (b +, a -) and where its dofs sit locally.
