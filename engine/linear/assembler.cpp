@@ -182,6 +182,8 @@ void Assembler::addStages(const Model& model, Workspace& ws, StageArgs args) {
           {args.stage * stages_ + args.column, 1.0, args.rule->weight[args.stage], offset == 0, args.tangent}, evaluate,
           args.tangent ? everyComponent_ : stageByStage_);
     }
+  // a together-component's only call of a residual-only evaluation starts its path afresh
+  args.samePath = false;
   if (!args.tangent) addStagesTogether(model, ws, args);
 }
 

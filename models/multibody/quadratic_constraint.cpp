@@ -1,6 +1,7 @@
 #include "models/multibody/quadratic_constraint.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 
 namespace mpx {
@@ -20,6 +21,8 @@ QuadraticConstraint::QuadraticConstraint(ConstraintSpec spec)
       spec_(std::move(spec)),
       positionCount_(static_cast<int>(spec_.positionDofs.size())),
       implied_(spec_.forms.size(), false) {
+  if (positionCount_ > kMaxConstrainedDofs)
+    throw std::logic_error("constraint '" + name() + "' couples more than kMaxConstrainedDofs positions");
   for (const QuadraticForm& form : spec_.forms)
     for (int a = 0; a < positionCount_; ++a) {
       if (form.touches(a)) sharesAForm_[a] |= form.support();
@@ -55,7 +58,7 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
     case Kind::Velocity:
       return (columnKind == Kind::Position && shareAForm(r, c)) || (columnKind == Kind::Lambda && touches(c, r));
     case Kind::Position:
-      return rate &&
+      return rate && augmented() &&
              ((columnKind == Kind::Position && shareAHessian(r, c)) || (columnKind == Kind::Mu && touches(c, r)));
     case Kind::Lambda:
       return (columnKind == Kind::Position && touches(r, c)) || (columnKind == Kind::Lambda && c == r);
