@@ -148,7 +148,8 @@ void CondensedSolver::condenseVelocities(const SparseMatrix& tangent) {
   double* reduced = reduced_.valuePtr();
   // each condensed column in a dense work column: K(j, c), minus the products in the order of
   // i, then copied into the condensed values (the work column is zero again afterwards); the
-  // products are never stored: a rigid link has some 42 000 of them (docs/performance.md)
+  // products are never stored: a rigid link had some 42 000 of them while its constraints
+  // claimed more than their forms reach (docs/performance.md)
   for (int column = 0; column < n; ++column) {
     if (isVelocity(column)) continue;
     for (SparseMatrix::InnerIterator it(tangent, column); it; ++it)
