@@ -116,16 +116,14 @@ void TwoPointGeometry::addSeparationRow(LocalRow& row, const Vec3& w) const {
       row.segment<3>(end.localPosition + 3 * k) += (end.sign * end.point.weights[k]) * w.transpose();
 }
 
-bool TwoPointGeometry::isPosition(int local) const {
+bool TwoPointGeometry::inEndBlock(int local, int End::*first) const {
   for (const End& end : ends_)
-    if (end.point.moves() && local >= end.localPosition && local < end.localPosition + 3 * end.point.terms) return true;
+    if (end.point.moves() && local >= end.*first && local < end.*first + 3 * end.point.terms) return true;
   return false;
 }
 
-bool TwoPointGeometry::isVelocity(int local) const {
-  for (const End& end : ends_)
-    if (end.point.moves() && local >= end.localVelocity && local < end.localVelocity + 3 * end.point.terms) return true;
-  return false;
-}
+bool TwoPointGeometry::isPosition(int local) const { return inEndBlock(local, &End::localPosition); }
+
+bool TwoPointGeometry::isVelocity(int local) const { return inEndBlock(local, &End::localVelocity); }
 
 }  // namespace mpx

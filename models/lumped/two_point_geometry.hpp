@@ -69,6 +69,9 @@ class TwoPointGeometry {
     double sign = 1.0;
     int localPosition = -1, localVelocity = -1;
   };
+  // Whether `local` lies in a moving end's block that starts at its `first` (positions or
+  // velocities).
+  bool inEndBlock(int local, int End::*first) const;
   // Add dForce/dy (3x3) to the momentum rows, y the position (or velocity) terms of the ends.
   void addMomentumTangent(LocalSystem& local, const Eigen::Matrix3d& dForce, bool velocityColumns) const;
 
