@@ -138,7 +138,9 @@ TEST(Corotation, KeepsTheSpinningGovernorsFactorisation) {
                 schemeName(scheme).c_str(), corotated.summary.factorizations, corotated.summary.newtonIterations,
                 asItWas.summary.factorizations, asItWas.summary.newtonIterations, steps);
     EXPECT_LT(corotated.summary.factorizations, 0.05 * steps);
-    EXPECT_GT(asItWas.summary.factorizations, 0.15 * steps);
+    // (as it was: 9 factorisations with eem and 82 with eem4 since the velocities' own predictor
+    // degree, 25 and 83 before it)
+    EXPECT_GE(asItWas.summary.factorizations, 3 * corotated.summary.factorizations);
     EXPECT_LT(corotated.summary.newtonIterations, asItWas.summary.newtonIterations);
     const double difference = ((corotated.states.back() - reference.states.back()).head(withScale).array() /
                                magnitude.head(withScale).array())

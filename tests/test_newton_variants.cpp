@@ -200,6 +200,32 @@ TEST(NewtonPredictor, PredictsAFreeFallExactly) {
   }
 }
 
+// A mechanism's velocities take their own predictor degree. The one-stage schemes keep the
+// positions on the constraints at the step ends, and the positions' increments are the
+// velocities' step means, so the velocities across turning constraints carry a component that
+// flips its sign from step to step: a higher degree mispredicts it by more, while the positions
+// stay smooth and gain from one. The free-floating chain (EEM at its dt 0.01, t in [0, 5]) took
+// 5.12 iterations per step with one degree for the whole state and takes 3.51 with two; the run
+// reaches the states of the run without the predictor to the Newton tolerance.
+TEST(NewtonPredictor, VelocitiesOfAConstrainedMechanismTakeTheirOwnDegree) {
+  const CompiledScene scene = loadScene(scenePath("free_floating_chain.xml"));
+  NewtonSettings off = scene.settings.newton, on = off;
+  off.predictor = false;
+  on.predictor = true;
+  const double dt = scene.settings.dt, tEnd = scene.settings.tEnd;
+  const History without = run(*scene.model, Scheme::Eem, dt, tEnd, off);
+  const History with = run(*scene.model, Scheme::Eem, dt, tEnd, on);
+  ASSERT_FALSE(with.summary.failed) << with.summary.failure;
+  EXPECT_LT(with.summary.newtonIterations, 4.0 * 500) << "without the predictor: " << without.summary.newtonIterations;
+  const Eigen::VectorXd magnitude = without.states.back().cwiseAbs() + scene.model->dofScale();
+  const int positionsAndVelocities = scene.model->layout().offset(Block::Thermal);
+  EXPECT_LT(((with.states.back() - without.states.back()).cwiseQuotient(magnitude))
+                .head(positionsAndVelocities)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-8);
+}
+
 // eem4's stages start from the polynomial through the past states at the stage times, plus the
 // last step's stage error (Gauss stages are an order lower than the ends the polynomial runs
 // through) where the steps resolve the motion. The two thermo-springs at dt 0.2 over t in

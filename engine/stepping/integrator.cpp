@@ -298,9 +298,17 @@ std::array<double, N> lagrangeWeights(const std::array<double, N>& times, int de
 }  // namespace
 
 void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const {
-  const auto weight = lagrangeWeights(pastTimes_, predictorDegree_, time);
-  out = weight[0] * pastStates_[0];
-  for (int k = 1; k <= predictorDegree_; ++k) out += weight[k] * pastStates_[k];
+  const Layout& layout = model_.layout();
+  const int velocities = layout.offset(Block::Velocity), velocityCount = layout.size(Block::Velocity);
+  auto predict = [&](int first, int count, int degree) {
+    const auto weight = lagrangeWeights(pastTimes_, degree, time);
+    auto part = out.segment(first, count);
+    part = weight[0] * pastStates_[0].segment(first, count);
+    for (int k = 1; k <= degree; ++k) part += weight[k] * pastStates_[k].segment(first, count);
+  };
+  predict(0, velocities, predictorDegree_[kRestOfState]);
+  predict(velocities, velocityCount, predictorDegree_[kVelocities]);
+  predict(velocities + velocityCount, layout.total() - velocities - velocityCount, predictorDegree_[kRestOfState]);
 }
 
 // A degree above one is chosen only where the line came within this of the last state reached:
@@ -309,24 +317,30 @@ void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const
 constexpr double kResolvedMiss = 0.2;
 
 void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reached) {
-  // each degree's miss in the increment test's norm, from one pass over the past states
+  // each degree's miss in the increment test's norm, for the velocities and for the rest of the
+  // state, from one pass over the past states
   const int highest = pastCount_ - 1;
   std::array<std::array<double, kPastStates>, kPastStates> weight{};
   for (int k = 1; k <= highest; ++k) weight[k] = lagrangeWeights(pastTimes_, k, time);
-  double miss[kPastStates] = {};
+  const Layout& layout = model_.layout();
+  const Eigen::Index velocities = layout.offset(Block::Velocity),
+                     afterVelocities = velocities + layout.size(Block::Velocity);
+  double miss[2][kPastStates] = {};
   for (Eigen::Index i = 0; i < reached.size(); ++i) {
     const double scale = 1.0 / (std::abs(reached[i]) + incrementScale_[i]);
+    double* partMiss = miss[i >= velocities && i < afterVelocities ? kVelocities : kRestOfState];
     for (int k = 1; k <= highest; ++k) {
       double value = 0.0;
       for (int j = 0; j <= k; ++j) value += weight[k][j] * pastStates_[j][i];
-      miss[k] = std::max(miss[k], std::abs(reached[i] - value) * scale);
+      partMiss[k] = std::max(partMiss[k], std::abs(reached[i] - value) * scale);
     }
   }
-  predictorDegree_ = 1;
-  motionResolved_ = miss[1] <= kResolvedMiss;
+  predictorDegree_.fill(1);
+  motionResolved_ = std::max(miss[kVelocities][1], miss[kRestOfState][1]) <= kResolvedMiss;
   if (!motionResolved_) return;
-  for (int k = 2; k <= highest; ++k)
-    if (miss[k] < miss[predictorDegree_]) predictorDegree_ = k;
+  for (int part : {kVelocities, kRestOfState})
+    for (int k = 2; k <= highest; ++k)
+      if (miss[part][k] < miss[part][predictorDegree_[part]]) predictorDegree_[part] = k;
 }
 
 bool Integrator::refactorize(const Eigen::VectorXd& zOld, double dt, bool repivot, StepOutcome& outcome) {
@@ -412,7 +426,7 @@ StepOutcome Integrator::advance(const Eigen::VectorXd& z, double t, double dt, E
       pastStates_[1] = z;
       pastTimes_[1] = t;
       pastCount_ = 2;
-      predictorDegree_ = 1;
+      predictorDegree_.fill(1);
       motionResolved_ = false;
     }
     pastStates_[0] = zNew;
@@ -439,7 +453,7 @@ void Integrator::resume(const LoopState& saved) {
   pastTimes_[1] = saved.predictorTime;
   pastTimes_[0] = saved.predictorTime + saved.predictorDt;
   pastCount_ = 2;  // a checkpoint before the first step holds no time: nothing continues it
-  predictorDegree_ = 1;
+  predictorDegree_.fill(1);
   // as a fresh integrator has them: a restart takes the same Newton path as the run it continues
   motionResolved_ = stageMissKept_ = oneFactorisationSufficed_ = false;
 }
