@@ -300,15 +300,17 @@ std::array<double, N> lagrangeWeights(const std::array<double, N>& times, int de
 void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const {
   const Layout& layout = model_.layout();
   const int velocities = layout.offset(Block::Velocity), velocityCount = layout.size(Block::Velocity);
-  auto predict = [&](int first, int count, int degree) {
-    const auto weight = lagrangeWeights(pastTimes_, degree, time);
-    auto part = out.segment(first, count);
-    part = weight[0] * pastStates_[0].segment(first, count);
-    for (int k = 1; k <= degree; ++k) part += weight[k] * pastStates_[k].segment(first, count);
+  std::array<std::array<double, kPastStates>, 2> weight{};
+  for (int part : {kVelocities, kRestOfState}) weight[part] = lagrangeWeights(pastTimes_, predictorDegree_[part], time);
+  auto predict = [&](int first, int count, int part) {
+    auto values = out.segment(first, count);
+    values = weight[part][0] * pastStates_[0].segment(first, count);
+    for (int k = 1; k <= predictorDegree_[part]; ++k) values += weight[part][k] * pastStates_[k].segment(first, count);
   };
-  predict(0, velocities, predictorDegree_[kRestOfState]);
-  predict(velocities, velocityCount, predictorDegree_[kVelocities]);
-  predict(velocities + velocityCount, layout.total() - velocities - velocityCount, predictorDegree_[kRestOfState]);
+  if (predictorDegree_[kVelocities] == predictorDegree_[kRestOfState]) return predict(0, layout.total(), kRestOfState);
+  predict(0, velocities, kRestOfState);
+  predict(velocities, velocityCount, kVelocities);
+  predict(velocities + velocityCount, layout.total() - velocities - velocityCount, kRestOfState);
 }
 
 // A degree above one is chosen only where the line came within this of the last state reached:
