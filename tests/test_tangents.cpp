@@ -292,6 +292,29 @@ TEST(TangentPattern, HoldsOnlyPairsTheConstraintsWrite) {
   }
 }
 
+// An EEM step reads velocities only in the kinematic rows and the inertias' momentum rows: the
+// rates of its dampers, joint forces and heat exchange are the positions' (x' - x)/dt, an
+// actuator and a temperature read no velocity at all. So the step tangent of every test scene
+// holds no zero entry in a velocity column; with the claims of dampers, actuators, joint forces
+// and heat links as they were (every column), 3 to 678 per scene (docs/performance.md, "Velocities
+// of their own: the predictor and the step's tangent pattern").
+TEST(TangentPattern, StepClaimsNoVelocityItDoesNotRead) {
+  for (const SceneBody& body : kScenes) {
+    const CompiledScene scene = compile(body, ThermalVariable::Entropy, DiscreteGradientForm::Partitioned);
+    const Layout& layout = scene.model->layout();
+    Integrator integrator(*scene.model, Scheme::Eem, NewtonSettings{});
+    const VectorXd zOld = scene.model->initialState();
+    const VectorXd magnitude = zOld.cwiseAbs() + scene.model->dofScale();
+    const Eigen::SparseMatrix<double>& K =
+        integrator.evaluate(zOld, zOld + 1e-2 * randomIsh(magnitude, 7), kTime, kTimeStep).tangent();
+    int zeros = 0;
+    for (int column = layout.offset(Block::Velocity); column < layout.offset(Block::Thermal); ++column)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, column); it; ++it)
+        zeros += it.row() != column && it.value() == 0.0;
+    EXPECT_EQ(zeros, 0) << body.name << ": zero entries in velocity columns";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllElements, StepTangent, testing::ValuesIn(stepCases()),
                          [](const testing::TestParamInfo<StepCase>& info) {
                            const StepCase& c = info.param;

@@ -13,8 +13,10 @@ class Actuator final : public Component {
  public:
   Actuator(std::string name, const Endpoint& a, const Endpoint& b, double force, TimeFunction profile);
 
-  // writes momentum rows only
-  bool couples(int row, int, LocalForm) const override { return !geometry_.isPosition(row); }
+  // writes momentum rows only, through the separation
+  bool couples(int row, int column, LocalForm) const override {
+    return !geometry_.isPosition(row) && !geometry_.isVelocity(column);
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -12,8 +12,11 @@ class Damper final : public Component {
  public:
   Damper(std::string name, const Endpoint& a, const Endpoint& b, double coefficient);
 
-  // writes momentum rows only
-  bool couples(int row, int, LocalForm) const override { return !geometry_.isPosition(row); }
+  // writes momentum rows only; the step's length rate is the positions' (lambda' - lambda)/dt, the
+  // rate form's reads the velocities
+  bool couples(int row, int column, LocalForm form) const override {
+    return !geometry_.isPosition(row) && (form != LocalForm::Step || !geometry_.isVelocity(column));
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

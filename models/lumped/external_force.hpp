@@ -10,6 +10,8 @@ class ExternalForce final : public Component {
  public:
   ExternalForce(std::string name, int positionDof, int velocityDof, const Vec3& force, TimeFunction profile);
 
+  // a force of time alone: no tangent
+  bool couples(int, int, LocalForm) const override { return false; }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

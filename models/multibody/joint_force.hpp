@@ -51,9 +51,13 @@ class JointForce final : public Component {
   explicit JointForce(JointForceSpec spec);
 
   // local order q, v, heat, internal: every row but the kinematic ones, of the coordinates the
-  // invariants touch and of heat and gamma, against the same columns
-  bool couples(int row, int column, LocalForm) const override {
-    return row >= n_ && reachedByInvariants(row) && reachedByInvariants(column);
+  // invariants touch and of heat and gamma, against the same columns. Velocities are read by the
+  // dissipative forces of the rate and stage forms only: the step's coordinate rate is the
+  // positions' (s' - s)/dt
+  bool couples(int row, int column, LocalForm form) const override {
+    const bool velocityColumn = column >= n_ && column < 2 * n_;
+    return row >= n_ && reachedByInvariants(row) && reachedByInvariants(column) &&
+           (!velocityColumn || (form != LocalForm::Step && dissipatesByRate()));
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -65,6 +69,10 @@ class JointForce final : public Component {
 
  private:
   static std::vector<int> collectDofs(const JointForceSpec& spec);
+  // Whether a damper, friction or a stop's damping acts on the coordinate rate.
+  bool dissipatesByRate() const {
+    return spec_.damping > 0.0 || spec_.friction > 0.0 || (spec_.stop && spec_.stop->damping > 0.0);
+  }
   // False for the position or velocity of a coordinate no invariant touches.
   bool reachedByInvariants(int local) const {
     if (local >= 2 * n_) return true;

@@ -122,13 +122,16 @@ ThermalNodeRef SceneBuild::thermalNode(ElementReader& in, const char* attribute)
 int SceneBuild::addThermalNode(const std::string& name, int dof, double dofScale) {
   const int node = static_cast<int>(thermalNodeNames.size());
   thermalNodeNames.push_back(name);
-  thermalNodes[name] = ThermalNodeRef{node, dof, {}};
+  thermalNodes[name] = ThermalNodeRef{node, dof, {}, {}};
   if (dof >= 0) scale[dof] = dofScale;
   return node;
 }
 
 void SceneBuild::addThermalNodeOwner(const std::string& node, std::unique_ptr<Component> component) {
-  thermalNodes.at(node).ownerDofs = component->dofs();
+  ThermalNodeRef& ref = thermalNodes.at(node);
+  ref.ownerDofs = component->dofs();
+  ref.ownerVelocity.clear();
+  for (int dof : ref.ownerDofs) ref.ownerVelocity.push_back(layout.blockOf(dof) == Block::Velocity);
   addComponent(std::move(component));
 }
 

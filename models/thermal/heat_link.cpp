@@ -18,8 +18,12 @@ int HeatLink::localIndex(int globalDof) const {
 
 HeatLink::HeatLink(std::string name, ThermalNodeRef a, ThermalNodeRef b, double conductivity)
     : Component(std::move(name), unionDofs(a, b)), ends_{std::move(a), std::move(b)}, conductivity_(conductivity) {
+  temperatureColumn_.assign(dofs().size(), false);
   for (int e = 0; e < 2; ++e) {
-    for (int dof : ends_[e].ownerDofs) ownerToLocal_[e].push_back(localIndex(dof));
+    for (std::size_t k = 0; k < ends_[e].ownerDofs.size(); ++k) {
+      ownerToLocal_[e].push_back(localIndex(ends_[e].ownerDofs[k]));
+      if (!ends_[e].ownerVelocity[k]) temperatureColumn_[ownerToLocal_[e].back()] = true;
+    }
     if (ends_[e].thermalDof >= 0) localThermal_[e] = localIndex(ends_[e].thermalDof);
   }
 }

@@ -8,12 +8,15 @@
 
 namespace mpx {
 
-// A thermal node as a link sees it: its index, its own thermal dof (-1 when prescribed) and
-// the global dofs its owner's published temperature derivative refers to.
+// A thermal node as a link sees it: its index, its own thermal dof (-1 when prescribed), the
+// global dofs its owner's published temperature derivative refers to, and which of them are
+// velocities: a temperature is a derivative of the internal energy, which holds no kinetic
+// energy, so its derivative there is zero.
 struct ThermalNodeRef {
   int node = -1;
   int thermalDof = -1;
   std::vector<int> ownerDofs;
+  std::vector<bool> ownerVelocity;
 };
 
 class HeatLink final : public Component {
@@ -21,8 +24,10 @@ class HeatLink final : public Component {
   HeatLink(std::string name, ThermalNodeRef a, ThermalNodeRef b, double conductivity);
 
   bool isCoupling() const override { return true; }
-  // writes the two thermal rows only
-  bool couples(int row, int, LocalForm) const override { return row == localThermal_[0] || row == localThermal_[1]; }
+  // writes the two thermal rows only, in the columns the node temperatures depend on
+  bool couples(int row, int column, LocalForm) const override {
+    return (row == localThermal_[0] || row == localThermal_[1]) && temperatureColumn_[column];
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
@@ -38,6 +43,7 @@ class HeatLink final : public Component {
   ThermalNodeRef ends_[2];
   std::vector<int> ownerToLocal_[2];  // owner-local dof -> link-local dof
   int localThermal_[2] = {-1, -1};
+  std::vector<bool> temperatureColumn_;  // per link-local dof: a node temperature depends on it
   double conductivity_;
 };
 

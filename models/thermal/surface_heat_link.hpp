@@ -17,8 +17,11 @@ class SurfaceHeatLink final : public Component {
                   double conductance);
 
   bool isCoupling() const override { return true; }
-  // writes the solid node's row and the lumped node's row only
-  bool couples(int row, int, LocalForm) const override { return row == 0 || row == lumpedRow_; }
+  // writes the solid node's row and the lumped node's row only, in the columns of the two
+  // temperatures
+  bool couples(int row, int column, LocalForm) const override {
+    return (row == 0 || row == lumpedRow_) && (column == 0 || !node_.ownerVelocity[column - 1]);
+  }
   void measure(const double*, Measures&) const override {}
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
