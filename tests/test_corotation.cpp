@@ -112,9 +112,9 @@ TEST(Corotation, StepTangentTurnsWithTheScene) {
 
 constexpr double kSpinTime = 0.2;  // the flyball governor turns by 0.4 pi
 
-// The flyball governor spins at 2 pi rad/s: its factorisation, kept as it was, stops contracting
-// within a few steps (the augmented-Lagrangian stiffness 1e6 turns with the bodies), and turned
-// with them it serves the whole run. The states are the full-Newton ones to the tolerance.
+// The flyball governor spins at 2 pi rad/s: its factorisation, kept as it was, wears out as the
+// augmented-Lagrangian stiffness 1e6 turns with the bodies, and turned with them it serves the
+// whole run. The states are the full-Newton ones to the tolerance.
 TEST(Corotation, KeepsTheSpinningGovernorsFactorisation) {
   const CompiledScene scene = loadScene(scenePath("flyball_governor.xml"));
   const Model& model = *scene.model;
@@ -138,8 +138,8 @@ TEST(Corotation, KeepsTheSpinningGovernorsFactorisation) {
                 schemeName(scheme).c_str(), corotated.summary.factorizations, corotated.summary.newtonIterations,
                 asItWas.summary.factorizations, asItWas.summary.newtonIterations, steps);
     EXPECT_LT(corotated.summary.factorizations, 0.05 * steps);
-    // (as it was: 9 factorisations with eem and 82 with eem4 since the velocities' own predictor
-    // degree, 25 and 83 before it)
+    // (turned: 2 factorisations with eem and with eem4; as it was: 9 and 82 since the velocities
+    // have a predictor degree of their own, 25 and 83 before)
     EXPECT_GE(asItWas.summary.factorizations, 3 * corotated.summary.factorizations);
     EXPECT_LT(corotated.summary.newtonIterations, asItWas.summary.newtonIterations);
     const double difference = ((corotated.states.back() - reference.states.back()).head(withScale).array() /

@@ -138,11 +138,12 @@ std::string bodyPointElements(ThermalVariable variable) {
                     coupling="0.5" rest_length="1" heat_capacity="1" reference_temperature="1" branch_stiffness="2"
                     viscosity="1" viscosity_activation="0.5" viscous_strain="0.05" temperature="1.2"/>
     <heat_link name="between" a="visco" b="thermo" conductivity="0.7"/>
-    <actuator name="push" a="right" a_point="1.2 -0.1 0.1" b="bob" force="2" profile="ramp" start="0" end="2"/>)";
+    <actuator name="push" a="right" a_point="1.2 -0.1 0.1" b="bob" force="2" profile="ramp" start="0" end="2"/>
+    <torque name="twist" on="left" torque="0.3 -0.2 0.5" profile="ramp" start="0" end="2"/>)";
 }
 
 // A hinge and a slider each started beyond one of their stops (damped), the hinge's stops
-// heating a reservoir.
+// heating a reservoir, and an undamped hinge spring (which reads no velocity in any form).
 std::string jointStops(ThermalVariable) {
   return R"(<gravity g="0 0 -9.81"/>
     <anchor name="ground" position="0 0 0"/>
@@ -156,7 +157,8 @@ std::string jointStops(ThermalVariable) {
     <joint_force name="hinge_stops" joint="hinge" lower="-1" upper="0.25" limit_stiffness="500" limit_damping="20"
                  heat_node="bearing"/>
     <joint_force name="slide_stops" joint="slide" lower="0.02" upper="0.4" limit_stiffness="3e4"
-                 limit_damping="100" damping="0.1"/>)";
+                 limit_damping="100" damping="0.1"/>
+    <joint_force name="hinge_spring" joint="hinge" stiffness="2" rest="0.1"/>)";
 }
 
 // Two tumbling links: a hinge under the augmented Lagrangian (multipliers at each eem4 stage)

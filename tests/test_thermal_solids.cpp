@@ -123,7 +123,12 @@ std::vector<ThermalCellCase> thermalCellCases() {
                        R"(<reservoir name="r" heat_capacity="50" temperature="290"/>
                         <surface_heat_link name="l" solid="cell" surface="x1" node="r" coefficient="30"/>
                         <fixed_temperature name="w" temperature="320"/>
-                        <surface_heat_link name="lw" solid="cell" surface="y0" node="w" coefficient="10"/>)",
+                        <surface_heat_link name="lw" solid="cell" surface="y0" node="w" coefficient="10"/>
+                        <mass name="m1" mass="1" position="3 0 0" velocity="0.1 0 0"/>
+                        <mass name="m2" mass="1" position="4 0.2 0" velocity="0 0.2 0"/>
+                        <thermo_spring name="ts" a="m1" b="m2" stiffness="10" coupling="0.5" rest_length="1"
+                                       heat_capacity="5" reference_temperature="300" temperature="310"/>
+                        <surface_heat_link name="lt" solid="cell" surface="z1" node="ts" coefficient="5"/>)",
                        scheme, 3e-2, variable});
       cases.push_back(
           {"hex8_viscous",

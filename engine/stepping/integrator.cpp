@@ -307,7 +307,11 @@ void Integrator::extrapolate(double time, Eigen::Ref<Eigen::VectorXd> out) const
     values = weight[part][0] * pastStates_[0].segment(first, count);
     for (int k = 1; k <= predictorDegree_[part]; ++k) values += weight[part][k] * pastStates_[k].segment(first, count);
   };
-  if (predictorDegree_[kVelocities] == predictorDegree_[kRestOfState]) return predict(0, layout.total(), kRestOfState);
+  // one pass over the state where both parts take the same degree
+  if (predictorDegree_[kVelocities] == predictorDegree_[kRestOfState]) {
+    predict(0, layout.total(), kRestOfState);
+    return;
+  }
   predict(0, velocities, kRestOfState);
   predict(velocities, velocityCount, kVelocities);
   predict(velocities + velocityCount, layout.total() - velocities - velocityCount, kRestOfState);

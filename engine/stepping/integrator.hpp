@@ -159,12 +159,9 @@ class Integrator {
   std::array<double, kPastStates> pastTimes_{};
   int pastCount_ = 0;
   // the degrees of the polynomials through the past states (below pastCount_), for the velocities
-  // and for the rest of the state. Where a mechanism's constraints turn, the one-stage schemes leave
-  // the velocities across them a component that flips its sign from step to step (they keep the
-  // positions on the constraints, and the positions' increments are the velocities' step means),
-  // which a polynomial of higher degree mispredicts by more, while the positions stay smooth: the
-  // flyball governor's positions come within 2e-7 at degree 3, its velocities 1.8e-4 at degree 2
-  // and twice that at 3.
+  // and for the rest of the state: across a mechanism's turning constraints the one-stage schemes
+  // leave the velocities a component that flips its sign from step to step (the positions'
+  // increments are the velocities' step means), which a higher degree mispredicts by more
   static constexpr int kVelocities = 0, kRestOfState = 1;
   std::array<int, 2> predictorDegree_{1, 1};
   bool motionResolved_ = false;                // the line came within kResolvedMiss of the last state reached

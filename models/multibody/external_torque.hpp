@@ -13,8 +13,11 @@ class ExternalTorque final : public Component {
   // firstDirectorDof: global dof of d1 (d2, d3 follow); velocityShift: velocity dof - position dof.
   ExternalTorque(std::string name, int firstDirectorDof, int velocityShift, const Vec3& torque, TimeFunction profile);
 
-  // local order: 9 director positions, their 9 velocity rows; writes the velocity rows only
-  bool couples(int row, int, LocalForm) const override { return row >= 9; }
+  // local order: 9 director positions, their 9 velocity rows; writes director i's velocity rows
+  // against its own positions, through tau x d_i (no entry on the cross product's diagonal)
+  bool couples(int row, int column, LocalForm) const override {
+    return row >= 9 && column < 9 && (row - 9) / 3 == column / 3 && row % 3 != column % 3;
+  }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

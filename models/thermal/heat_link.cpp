@@ -1,6 +1,7 @@
 #include "models/thermal/heat_link.hpp"
 
 #include <algorithm>
+#include <cassert>
 
 namespace mpx {
 
@@ -20,6 +21,7 @@ HeatLink::HeatLink(std::string name, ThermalNodeRef a, ThermalNodeRef b, double 
     : Component(std::move(name), unionDofs(a, b)), ends_{std::move(a), std::move(b)}, conductivity_(conductivity) {
   temperatureColumn_.assign(dofs().size(), false);
   for (int e = 0; e < 2; ++e) {
+    assert(ends_[e].ownerVelocity.size() == ends_[e].ownerDofs.size());
     for (std::size_t k = 0; k < ends_[e].ownerDofs.size(); ++k) {
       ownerToLocal_[e].push_back(localIndex(ends_[e].ownerDofs[k]));
       if (!ends_[e].ownerVelocity[k]) temperatureColumn_[ownerToLocal_[e].back()] = true;

@@ -1,6 +1,7 @@
 #include "models/thermal/surface_heat_link.hpp"
 
 #include <algorithm>
+#include <cassert>
 
 namespace mpx {
 
@@ -17,6 +18,7 @@ SurfaceHeatLink::SurfaceHeatLink(std::string name, int solidThermalDof, NodalThe
       thermalVariable_(thermalVariable),
       node_(std::move(node)),
       conductance_(conductance) {
+  assert(node_.ownerVelocity.size() == node_.ownerDofs.size());
   if (node_.thermalDof >= 0)
     lumpedRow_ = static_cast<int>(std::find(dofs().begin(), dofs().end(), node_.thermalDof) - dofs().begin());
 }
