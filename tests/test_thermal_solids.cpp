@@ -70,6 +70,7 @@ struct ThermalCellCase {
   Scheme scheme;
   double perturbation = 3e-2;            // of the moved state, relative to the dofs' magnitudes
   const char* variable = "temperature";  // what the nodal thermal dofs hold
+  const char* expansion = "1e-3";        // beta (0: heat and motion meet only through a branch)
 };
 
 std::string caseName(const ThermalCellCase& c) {
@@ -82,9 +83,9 @@ std::string thermalCell(const ThermalCellCase& c) {
   return std::string(R"(<metriplex name="thermal_cell"><simulation dt="0.1" t_end="10" thermal_variable=")") +
          c.variable + R"("/>
     <solid name="cell" young="1000" poisson="0.3" density="10" velocity="0.1 -0.2 0.3"
-           angular_velocity="0.5 0.2 -0.4" heat_capacity="100" conductivity="40" expansion="1e-3"
-           reference_temperature="300" temperature="310" )" +
-         c.solid + "/>" + c.extra + "</metriplex>";
+           angular_velocity="0.5 0.2 -0.4" heat_capacity="100" conductivity="40" expansion=")" +
+         c.expansion + R"(" reference_temperature="300" temperature="310" )" + c.solid + "/>" + c.extra +
+         "</metriplex>";
 }
 
 class ThermalCellTangent : public ::testing::TestWithParam<ThermalCellCase> {};
@@ -134,6 +135,11 @@ std::vector<ThermalCellCase> thermalCellCases() {
           {"hex8_viscous",
            R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100" viscosity_activation="0.02")",
            "", scheme, 3e-2, variable});
+      // without expansion (and activation) the pattern leaves the thermo-mechanical pairs out
+      cases.push_back({"hex8_unexpanding", R"(mesh="box" cells="1 1 1")", "", scheme, 3e-2, variable, "0"});
+      cases.push_back({"hex8_viscous_unexpanding",
+                       R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100")", "", scheme,
+                       3e-2, variable, "0"});
     }
   // the bar's tetrahedra are 0.5 across in a body 4 long: a smaller perturbation keeps them uninverted
   cases.push_back(

@@ -129,6 +129,31 @@ Mat3 SolidElement::viscousStrain(const double* z, int point) const {
   return gamma;
 }
 
+bool SolidElement::couples(int row, int column, LocalForm) const {
+  enum class Kind { Position, Velocity, Strain, Thermal };
+  auto kind = [&](int local) {
+    if (local < 3 * nodes_) return Kind::Position;
+    if (local < 6 * nodes_) return Kind::Velocity;
+    return local < firstThermal_ ? Kind::Strain : Kind::Thermal;
+  };
+  const bool expands = spec_.thermal && spec_.thermal->expansion != 0.0;
+  const bool activated = spec_.thermal && spec_.thermal->viscosityActivation != 0.0;
+  const Kind columnKind = kind(column);
+  switch (kind(row)) {
+    case Kind::Velocity:
+      return columnKind == Kind::Position || columnKind == Kind::Strain || (columnKind == Kind::Thermal && expands);
+    case Kind::Strain:
+      return columnKind == Kind::Position || (columnKind == Kind::Thermal && activated) ||
+             (columnKind == Kind::Strain && (row - 6 * nodes_) / 6 == (column - 6 * nodes_) / 6);
+    case Kind::Thermal:
+      return columnKind == Kind::Thermal || columnKind == Kind::Strain ||
+             (columnKind == Kind::Position && (expands || spec_.branch));
+    case Kind::Position:
+      break;
+  }
+  return false;  // the kinematic rows are the inertia's
+}
+
 void SolidElement::measure(const double* z, Measures& out) const {
   const NodePositions x = positions(z);
   for (std::size_t q = 0; q < spec_.points.size(); ++q) {

@@ -47,18 +47,12 @@ class SolidElement final : public Component {
  public:
   explicit SolidElement(SolidElementSpec spec);
 
-  // momentum and thermal rows depend on positions, strains and temperatures, the viscous rows
-  // of a point on positions, temperatures (through the viscosity) and that point's own strains;
-  // nothing depends on velocities
-  // (a rate-form thermal row does, on the position rates, which share the position columns)
-  bool couples(int row, int column, LocalForm) const override {
-    const int strains = 6 * nodes_;
-    if (row < 3 * nodes_ || (column >= 3 * nodes_ && column < strains)) return false;
-    const bool strainRow = row >= strains && row < firstThermal_,
-               strainColumn = column >= strains && column < firstThermal_;
-    if (strainRow && strainColumn) return (row - strains) / 6 == (column - strains) / 6;
-    return !strainRow || column < strains || column >= firstThermal_;
-  }
+  // momentum rows depend on positions, strains and, through thermal expansion, temperatures; the
+  // viscous rows of a point on positions, that point's own strains and, through the viscosity's
+  // activation, temperatures; heat rows on temperatures, and on positions and strains through
+  // expansion and the branch's dissipation; nothing depends on velocities (a rate-form heat row
+  // reads the position rates, which share the position columns)
+  bool couples(int row, int column, LocalForm) const override;
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
