@@ -140,6 +140,10 @@ std::vector<ThermalCellCase> thermalCellCases() {
       cases.push_back({"hex8_viscous_unexpanding",
                        R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100")", "", scheme,
                        3e-2, variable, "0"});
+      cases.push_back(
+          {"hex8_activated_unexpanding",
+           R"(mesh="box" cells="1 1 1" branch_lambda="200" branch_mu="50" viscosity="100" viscosity_activation="0.02")",
+           "", scheme, 3e-2, variable, "0"});
     }
   // the bar's tetrahedra are 0.5 across in a body 4 long: a smaller perturbation keeps them uninverted
   cases.push_back(
