@@ -14,9 +14,7 @@ class Actuator final : public Component {
   Actuator(std::string name, const Endpoint& a, const Endpoint& b, double force, TimeFunction profile);
 
   // writes momentum rows only, through the separation
-  bool couples(int row, int column, LocalForm) const override {
-    return !geometry_.isPosition(row) && !geometry_.isVelocity(column);
-  }
+  bool couples(int row, int column, LocalForm) const override { return geometry_.couples(row, column, false); }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;
   void rateLocal(const RateArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -15,7 +15,7 @@ class Damper final : public Component {
   // writes momentum rows only; the step's length rate is the positions' (lambda' - lambda)/dt, the
   // rate form's reads the velocities
   bool couples(int row, int column, LocalForm form) const override {
-    return !geometry_.isPosition(row) && (form != LocalForm::Step || !geometry_.isVelocity(column));
+    return geometry_.couples(row, column, form != LocalForm::Step);
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

@@ -46,7 +46,7 @@ class LumpedElement final : public Component {
   // writes momentum, thermal and internal rows, never the end points' kinematic rows, and reads
   // the separation's rate from the position rates, never the velocities
   bool couples(int row, int column, LocalForm) const override {
-    return !geometry_ || (!geometry_->isPosition(row) && !geometry_->isVelocity(column));
+    return !geometry_ || geometry_->couples(row, column, false);
   }
   void measure(const double* z, Measures& out) const override;
   void eemLocal(const StepArgs& args, Workspace& ws, LocalSystem& out, Flows& flows) const override;

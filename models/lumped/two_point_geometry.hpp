@@ -57,12 +57,16 @@ class TwoPointGeometry {
   void addSeparationVelocityTangent(LocalSystem& local, const Eigen::Matrix3d& dForceDw) const;
   // Row over local dofs of d(w . d)/dz.
   void addSeparationRow(LocalRow& row, const Vec3& w) const;
-  // Whether local dof `local` is an end point's position (a row these elements never write), or
-  // its velocity.
-  bool isPosition(int local) const;
-  bool isVelocity(int local) const;
+  // The pattern of a two-point element: the momentum rows (never the ends' kinematic rows),
+  // against the positions and, for an element whose force reads them, the velocities.
+  bool couples(int row, int column, bool readsVelocities) const {
+    return !isPosition(row) && (readsVelocities || !isVelocity(column));
+  }
 
  private:
+  // Whether local dof `local` is an end point's position, or its velocity.
+  bool isPosition(int local) const;
+  bool isVelocity(int local) const;
   // An end point with the sign of its force (b +, a -) and where its dofs sit locally.
   struct End {
     Endpoint point;
