@@ -227,6 +227,6 @@ PYBIND11_MODULE(_metriplex, module) {
              py::arg("max_order") = py::none(), py::arg("sundials_klu") = false, py::arg("dt_out") = py::none(),
              py::arg("checkpoint_every") = 0, py::arg("restart") = "", py::arg("budget") = false,
              py::arg("urdf_limits") = false,
-             "Run a scene file (str or path) or a Scene with the options of `metriplex run` (docs/python.md). "
+             "Run a scene file (str or path) or a Scene with the options of `metriplex run` (docs/library.md). "
              "Writes files only into `out` when given. Raises InputError (a ValueError) on invalid input.");
 }

@@ -5,7 +5,7 @@
     r = metriplex.run("scenes/two_thermo_springs.xml", integrator="eem", dt=0.2, t_end=20)
     r.history["energy"], r.summary["max_relative_energy_drift"]
 
-See docs/python.md.
+See docs/library.md.
 """
 from dataclasses import dataclass
 
