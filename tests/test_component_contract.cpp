@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace mpx::test {
 namespace {
 
@@ -140,6 +142,8 @@ TEST(ComponentContract, ANonFiniteMeasureStopsEveryTimeLoopAtItsStepNamingTheCom
     EXPECT_NE(summary.failure.find("measured by gauge is not finite"), std::string::npos) << summary.failure;
     // the history ends at the last finite state: x(t) = 1 - t stays above the floor to t = 0.55
     EXPECT_LE(lastTime, 1.0 - kGaugeFloor + 1e-9);
+    std::printf("%s: history ends at t = %.3f\n", name, lastTime);
+    EXPECT_GT(lastTime, 0.3);
     if (std::string(name) == "eem") {
       EXPECT_EQ(summary.failedStep, 6);
       EXPECT_NEAR(summary.failedTime, 0.5, 1e-12);

@@ -211,6 +211,10 @@ TEST(NewtonPredictor, SavesIterationsOnASmoothTrajectory) {
   on.predictor = true;
   const History without = run(*scene.model, Scheme::Eem, 0.2, 20.0, off);
   const History with = run(*scene.model, Scheme::Eem, 0.2, 20.0, on);
+  // (a run that stopped early would count fewer iterations)
+  ASSERT_FALSE(without.summary.failed) << without.summary.failure;
+  ASSERT_FALSE(with.summary.failed) << with.summary.failure;
+  ASSERT_EQ(with.summary.steps, without.summary.steps);
   EXPECT_LT(with.summary.newtonIterations, 0.9 * without.summary.newtonIterations)
       << with.summary.newtonIterations << " against " << without.summary.newtonIterations;
 }

@@ -448,6 +448,16 @@ TEST(PlanarJoint, LeavesExactlyTheInPlaneMotionFree) {
   }
   EXPECT_NEAR(std::abs(normalDirector.z()), 1.0, 1e-10);
   EXPECT_LT(h.summary.maxEnergyBalanceError, 1e-10);
+  // the spin about the normal is free: the angular momentum about the centre keeps its normal
+  // component I_zz spin at every step (a joint that locked the turn would take it to zero, or
+  // flip it from step to step)
+  double spinDrift = 0.0;
+  for (std::size_t n = 0; n < h.states.size(); ++n) {
+    const Vec3 centre = centreOf(*compiled.model, h.states[n], "puck");
+    const double spinMomentum = (h.angularMomentum[n] - centre.cross(h.momentum[n])).z();
+    spinDrift = std::max(spinDrift, std::abs(spinMomentum - 0.02 * spin));
+  }
+  EXPECT_LT(spinDrift, 1e-10 * 0.02 * spin);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -17,7 +17,10 @@ inline std::size_t firstIndexAfter(const History& h, double t) {
 // An isolated body from tFree on (after its loads): E, L and J constant to 1e-10 (L against |J|
 // over the body's size), S never decreasing and grown over the run.
 inline void expectIsolatedBalances(const History& h, const char* label, double tFree = 2.0, double size = 10.0) {
+  // a run that stopped early would be judged on its shorter history
+  ASSERT_FALSE(h.summary.failed) << label << ": " << h.summary.failure;
   const std::size_t free = firstIndexAfter(h, tFree);
+  ASSERT_LT(free + 1, h.energy.size()) << label << ": no step after t = " << tFree;
   double energyDrift = 0.0, momentumDrift = 0.0, angularDrift = 0.0;
   for (std::size_t n = free; n < h.energy.size(); ++n) {
     energyDrift = std::max(energyDrift, std::abs(h.energy[n] - h.energy[free]));
@@ -36,6 +39,7 @@ inline void expectIsolatedBalances(const History& h, const char* label, double t
 // At every step: E' - E = W + Q - D to 1e-10 of the run's largest energy, and the entropy
 // production S' - S - S_boundary non-negative (to round-off).
 inline void expectStepBalances(const History& h, const char* label) {
+  ASSERT_FALSE(h.summary.failed) << label << ": " << h.summary.failure;
   const double scale = largestEnergy(h);
   double worst = 0.0, leastProduction = INFINITY;
   for (std::size_t n = 1; n < h.energy.size(); ++n) {

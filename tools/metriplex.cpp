@@ -49,9 +49,10 @@ void addUrdfLimitsOption(CLI::App* command, RunRequest& request) {
 
 // Adaptive steps of the one-step integrators and the tolerances they share with IDA.
 void addToleranceOptions(CLI::App* command, RunRequest& request) {
-  command->add_flag("--adaptive", request.adaptive,
-                    "eem, eem4, midpoint, trapezoidal: adaptive steps to --rtol/--atol, --dt the first step (default: the "
-                    "scene's simulation adaptive)");
+  command->add_flag(
+      "--adaptive", request.adaptive,
+      "eem, eem4, midpoint, trapezoidal: adaptive steps to --rtol/--atol, --dt the first step (default: the "
+      "scene's simulation adaptive)");
   command->add_option("--rtol", request.relativeTolerance,
                       "ida and adaptive steps: relative tolerance (default: the scene's simulation rtol, 1e-6)");
   command->add_option("--atol", request.absoluteTolerance,
