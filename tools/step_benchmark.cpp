@@ -113,8 +113,8 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 // scenes/lblock_thermoelastic.xml (same elastic constants, so only the thermal part differs).
 enum class LBlockVariant { Elastic, Viscoelastic, Thermoelastic };
 // Full Newton (a factorisation per iteration), or the simplified Newton the L-block scenes of
-// scenes/ ask for (<solver reuse_contraction="0.5" symmetric_factorisation="true"/>), with the
-// tangent's LU or, on large systems, the Cholesky factor of its symmetric part.
+// scenes/ ask for (<solver reuse_contraction="0.5"/>), with the tangent's LU or, on large
+// systems, the Cholesky factor of its symmetric part (<solver symmetric_factorisation>).
 enum class LBlockNewton { Full, Simplified, SimplifiedSymmetric };
 
 SceneSpec lblock(int level, LBlockVariant variant, double dt, LBlockNewton newton) {

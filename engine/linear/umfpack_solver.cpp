@@ -2,10 +2,13 @@
 
 namespace mpx {
 
-UmfpackSolver::UmfpackSolver(int size)
-    : solution_(size), integerWork_(size), realWork_(5 * static_cast<std::size_t>(size)) {
+UmfpackSolver::UmfpackSolver(int size) : solution_(size), integerWork_(size), realWork_(size) {
   umfpack_di_defaults(control_);
   control_[UMFPACK_ORDERING] = UMFPACK_ORDERING_METIS;
+  // No iterative refinement: Newton's own iterations refine the solution against the true
+  // residual, and each refinement step costs a product with the matrix and another solve (it
+  // took 45 % of a simplified-Newton step of the level-4 L-block, docs/performance.md).
+  control_[UMFPACK_IRSTEP] = 0;
 }
 
 UmfpackSolver::~UmfpackSolver() {
@@ -21,13 +24,13 @@ bool UmfpackSolver::factorize(const Eigen::SparseMatrix<double>& matrix, bool) {
       umfpack_di_symbolic(n, n, colStart, rowIndex, matrix.valuePtr(), &symbolic_, control_, info_) != UMFPACK_OK)
     return false;
   if (numeric_) umfpack_di_free_numeric(&numeric_);
-  matrix_ = &matrix;
   return umfpack_di_numeric(colStart, rowIndex, matrix.valuePtr(), symbolic_, &numeric_, control_, info_) == UMFPACK_OK;
 }
 
 void UmfpackSolver::solve(Eigen::VectorXd& rhs) {
-  umfpack_di_wsolve(UMFPACK_A, matrix_->outerIndexPtr(), matrix_->innerIndexPtr(), matrix_->valuePtr(),
-                    solution_.data(), rhs.data(), numeric_, control_, info_, integerWork_.data(), realWork_.data());
+  // without refinement UMFPACK does not read the matrix
+  umfpack_di_wsolve(UMFPACK_A, nullptr, nullptr, nullptr, solution_.data(), rhs.data(), numeric_, control_, info_,
+                    integerWork_.data(), realWork_.data());
   rhs.swap(solution_);
 }
 

@@ -27,7 +27,6 @@ class UmfpackSolver final : public SparseLu {
   double info_[UMFPACK_INFO];
   void* symbolic_ = nullptr;
   void* numeric_ = nullptr;
-  const Eigen::SparseMatrix<double>* matrix_ = nullptr;  // the last factorised matrix
   Eigen::VectorXd solution_;
   std::vector<int> integerWork_;
   std::vector<double> realWork_;
