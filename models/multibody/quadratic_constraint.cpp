@@ -92,16 +92,17 @@ void QuadraticConstraint::measure(const double* z, Measures& out) const {
 
 void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, Flows&) const {
   const ConstraintVector q0 = gather(args.zOld, 0), q1 = gather(args.zNew, 0);
-  const ConstraintVector qMid = 0.5 * (q0 + q1);
   const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
   auto r = out.residual();
   auto K = out.tangent();
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi
-    const ConstraintVector gradientEnd = form.gradientAt(q1), gradientMid = form.gradientAt(qMid);
+    // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi: the gradient at
+    // the midpoint, the mean of the end points' (two products with H, not three)
+    const ConstraintVector gradientStart = form.gradientAt(q0), gradientEnd = form.gradientAt(q1);
+    const ConstraintVector gradientMid = 0.5 * (gradientStart + gradientEnd);
     const double phiEnd = form.valueAt(q1, gradientEnd);
-    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.valueAt(q0) + phiEnd);
+    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.valueAt(q0, gradientStart) + phiEnd);
     r.segment(n, n) += force * gradientMid;
     if (args.tangent) {
       K.block(n, 0, n, n).noalias() += (0.5 * spec_.stiffness) * gradientMid * gradientEnd.transpose();
