@@ -112,15 +112,16 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
     // mu is not used by EEM (mu = 0), nor lambda of an implied form
     const int lambda = 2 * n + k, mu = 2 * n + m + k;
     r[mu] = args.zNew[spec_.firstMultiplierDof + m + k];
-    K(mu, mu) = 1.0;
     if (implied_[k]) {
       r[lambda] = args.zNew[spec_.firstMultiplierDof + k];
-      K(lambda, lambda) = 1.0;
+      if (args.tangent) K(mu, mu) = K(lambda, lambda) = 1.0;
       continue;
     }
     // lambda's row: the constraint at the end of the step
-    K.block(n, lambda, n, 1) += gradientMid;
     r[lambda] = phiEnd;
+    if (!args.tangent) continue;
+    K(mu, mu) = 1.0;
+    K.block(n, lambda, n, 1) += gradientMid;
     K.block(lambda, 0, 1, n) = gradientEnd.transpose();
   }
 }
@@ -149,18 +150,19 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
     // an implied form's multipliers are held at zero: lambda = mu = 0
     if (implied_[k]) {
       r[lambda] = args.z[spec_.firstMultiplierDof + k];
-      K(lambda, lambda) = args.alpha;
       r[mu] = muValue;
-      K(mu, mu) = args.alpha;
+      if (positionTangent) K(lambda, lambda) = K(mu, mu) = args.alpha;
       continue;
     }
-    K.block(n, lambda, n, 1) += args.alpha * gradient;
     r.head(n) += muValue * gradient;
-    if (positionTangent) form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
-    K.block(0, mu, n, 1) += args.alpha * gradient;
     r[lambda] = phi;
-    K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
     r[mu] = gradient.dot(v);
+    // every multiplier entry of the tangent is alpha times a derivative (none in IDA's residual calls)
+    if (!positionTangent) continue;
+    form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
+    K.block(n, lambda, n, 1) += args.alpha * gradient;
+    K.block(0, mu, n, 1) += args.alpha * gradient;
+    K.block(lambda, 0, 1, n) = args.alpha * gradient.transpose();
     K.block(mu, 0, 1, n) = args.alpha * form.hessianTimes(v).transpose();
     K.block(mu, n, 1, n) = args.alpha * gradient.transpose();
   }
