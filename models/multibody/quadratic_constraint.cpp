@@ -97,15 +97,22 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
   auto K = out.tangent();
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
+    const std::vector<int>& support = form.supportCoordinates();
     // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi: the gradient at
     // the midpoint, the mean of the end points' (two products with H, not three)
-    const ConstraintVector gradientStart = form.gradientAt(q0), gradientEnd = form.gradientAt(q1);
-    const ConstraintVector gradientMid = 0.5 * (gradientStart + gradientEnd);
-    const double phiEnd = form.valueAt(q1, gradientEnd);
-    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (form.valueAt(q0, gradientStart) + phiEnd);
-    r.segment(n, n) += force * gradientMid;
+    SupportValues gradientStart, gradientEnd, gradientMid;
+    const double phiStart = form.valueAndSupportGradient(q0, gradientStart);
+    const double phiEnd = form.valueAndSupportGradient(q1, gradientEnd);
+    const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (phiStart + phiEnd);
+    for (std::size_t s = 0; s < support.size(); ++s) {
+      gradientMid[s] = 0.5 * (gradientStart[s] + gradientEnd[s]);
+      r[n + support[s]] += force * gradientMid[s];
+    }
+    // the tangent takes the gradients whole
+    const ConstraintVector wholeMid = args.tangent ? form.fromSupport(gradientMid, n) : ConstraintVector();
+    const ConstraintVector wholeEnd = args.tangent ? form.fromSupport(gradientEnd, n) : ConstraintVector();
     if (args.tangent) {
-      K.block(n, 0, n, n).noalias() += (0.5 * spec_.stiffness) * gradientMid * gradientEnd.transpose();
+      K.block(n, 0, n, n).noalias() += (0.5 * spec_.stiffness) * wholeMid * wholeEnd.transpose();
       form.addHessian(0.5 * force, K.block(n, 0, n, n));
     }
     if (!augmented()) continue;
@@ -121,8 +128,8 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
     r[lambda] = phiEnd;
     if (!args.tangent) continue;
     K(mu, mu) = 1.0;
-    K.block(n, lambda, n, 1) += gradientMid;
-    K.block(lambda, 0, 1, n) = gradientEnd.transpose();
+    K.block(n, lambda, n, 1) += wholeMid;
+    K.block(lambda, 0, 1, n) = wholeEnd.transpose();
   }
 }
 
@@ -131,14 +138,16 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
   const int n = positionCount_, m = static_cast<int>(spec_.forms.size());
   auto r = out.residual();
   auto K = out.tangent();
+  // the tangent only where it has a z-part (not in IDA's residual calls)
+  const bool positionTangent = args.alpha != 0.0;
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const ConstraintVector gradient = form.gradientAt(q);
-    const double phi = form.valueAt(q, gradient);
+    const std::vector<int>& support = form.supportCoordinates();
+    SupportValues supportGradient;
+    const double phi = form.valueAndSupportGradient(q, supportGradient);
     const double force = multiplier(args.z, k) + spec_.stiffness * phi;
-    r.segment(n, n) += force * gradient;
-    // the n x n blocks of the tangent only where it has a z-part (not in IDA's residual calls)
-    const bool positionTangent = args.alpha != 0.0;
+    for (std::size_t s = 0; s < support.size(); ++s) r[n + support[s]] += force * supportGradient[s];
+    const ConstraintVector gradient = positionTangent ? form.fromSupport(supportGradient, n) : ConstraintVector();
     if (positionTangent) {
       K.block(n, 0, n, n).noalias() += (args.alpha * spec_.stiffness) * gradient * gradient.transpose();
       form.addHessian(args.alpha * force, K.block(n, 0, n, n));
@@ -154,9 +163,12 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
       if (positionTangent) K(lambda, lambda) = K(mu, mu) = args.alpha;
       continue;
     }
-    r.head(n) += muValue * gradient;
     r[lambda] = phi;
-    r[mu] = gradient.dot(v);
+    r[mu] = 0.0;
+    for (std::size_t s = 0; s < support.size(); ++s) {
+      r[support[s]] += muValue * supportGradient[s];
+      r[mu] += supportGradient[s] * v[support[s]];
+    }
     // every multiplier entry of the tangent is alpha times a derivative (none in IDA's residual calls)
     if (!positionTangent) continue;
     form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
@@ -195,6 +207,7 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
   }
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
+    const std::vector<int>& support = form.supportCoordinates();
     const bool held = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
     double lambda[CollocationRule::kMostStages] = {};
     if (held)
@@ -217,14 +230,18 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
       double multiplier = 0.0;
       for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-      const ConstraintVector gradient = form.gradientAt(q);
-      const double phi = form.valueAt(q, gradient);
+      SupportValues supportGradient;
+      const double phi = form.valueAndSupportGradient(q, supportGradient);
       const double value = multiplier + spec_.stiffness * phi;
+      double rateOfPhiHere = 0.0;
+      if (held)
+        for (std::size_t s = 0; s < support.size(); ++s) rateOfPhiHere += supportGradient[s] * rate[support[s]];
+      const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient, n) : ConstraintVector();
       for (int i = 0; i < count; ++i) {
         const int l = firstStage + i;
         const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
-        force[i] += (test * value) * gradient;
-        if (held) rateOfPhi[i] += test * gradient.dot(rate);
+        for (std::size_t s = 0; s < support.size(); ++s) force[i][support[s]] += (test * value) * supportGradient[s];
+        rateOfPhi[i] += test * rateOfPhiHere;
         if (!args.tangent) continue;
         const double valueCoefficient = rule.fineValue[p][column + 1];
         hessianWeight += test * valueCoefficient * value;

@@ -6,6 +6,7 @@
 // product goes through them.
 #include <Eigen/Dense>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +18,8 @@ using ConstraintVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstra
 using ConstraintMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstrainedDofs, kMaxConstrainedDofs>;
 using ConstraintRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxConstrainedDofs>;
+// Values at a form's support coordinates, in the order of QuadraticForm::supportCoordinates().
+using SupportValues = std::array<double, kMaxConstrainedDofs>;
 
 class QuadraticForm {
  public:
@@ -32,6 +35,13 @@ class QuadraticForm {
     return 0.5 * q.dot(gradientAtQ + gradient_) + constant_;
   }
   double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
+  // phi(q), and grad phi(q) at the support coordinates only: the residual of a constraint works
+  // on the few coordinates a form touches instead of all 24
+  double valueAndSupportGradient(const ConstraintVector& q, SupportValues& gradient) const;
+  // The coordinates phi depends on, in increasing order.
+  const std::vector<int>& supportCoordinates() const { return supportCoordinates_; }
+  // The full gradient from its support values.
+  ConstraintVector fromSupport(const SupportValues& values, int size) const;
   // Whether phi depends on coordinate i (its gradient's entry i can be non-zero).
   bool touches(int i) const { return support_ >> i & 1u; }
   // The coordinates phi depends on, and those H couples to coordinate i, as bit masks.
@@ -47,11 +57,13 @@ class QuadraticForm {
   struct Entry {
     int row, column;
     double value;
+    int rowSlot;  // the position of row in supportCoordinates_
   };
   std::vector<Entry> entries_;  // H's nonzeros, by column
   ConstraintVector gradient_;
   double constant_;
   std::uint32_t support_ = 0;  // bit i: H's row i or g_i is non-zero
+  std::vector<int> supportCoordinates_;
 };
 
 }  // namespace mpx
