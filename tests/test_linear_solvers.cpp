@@ -1,13 +1,19 @@
 // The factorisations of engine/linear beyond KLU: the symmetric-part factorisation of
 // cholmod_solver solves with (A + A^T)/2 where that is positive definite, and with A itself
 // (UMFPACK) from the first matrix whose symmetric part is not; the dense LU of the smallest
-// systems solves with A and reports a singular one.
+// systems solves with A and reports a singular one; the LU of the large systems solves to
+// round-off without iterative refinement.
 #include "engine/linear/cholmod_solver.hpp"
 #include "engine/linear/condensed_solver.hpp"
 #include "engine/linear/dense_lu.hpp"
+#include "engine/linear/sparse_lu.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
+
+#include <cstdio>
+#include <memory>
+#include <utility>
 
 namespace mpx::test {
 namespace {
@@ -99,6 +105,28 @@ TEST(SymmetricFactorisation, FallsBackToTheLuOfTheMatrixWhereTheSymmetricPartIsI
   // and stays with the LU for later matrices, also positive definite ones
   const Eigen::SparseMatrix<double> b = bandedMatrix(n, 4.0, 0.5);
   EXPECT_LT((b * factorizeAndSolve(solver, b, rhs) - rhs).norm(), 1e-12 * rhs.norm());
+}
+
+// The large systems' LU (UMFPACK) solves without iterative refinement, so each solve is the
+// factors' triangular solves alone: it must still solve a non-symmetric system to round-off
+// (backward error), answer alike for every right-hand side it is handed after one factorisation
+// (simplified Newton reuses it), and take new values on the same pattern.
+TEST(LargeSystemLu, SolvesToRoundOffWithoutRefinement) {
+  const int n = kLargeSystem;
+  const std::unique_ptr<SparseLu> lu = makeSparseLu(n);
+  EXPECT_STREQ(lu->name(), "UMFPACK");
+  for (const auto& [diagonal, skew] : {std::pair{4.0, 0.5}, std::pair{2.5, -0.3}}) {
+    const Eigen::SparseMatrix<double> a = bandedMatrix(n, diagonal, skew);
+    ASSERT_TRUE(lu->factorize(a, false));
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, 1.0, 2.0 + k).array().sin();
+      Eigen::VectorXd x = rhs;
+      lu->solve(x);
+      const double backwardError = (a * x - rhs).norm() / (a.norm() * x.norm() + rhs.norm());
+      std::printf("UMFPACK, diagonal %.1f, right-hand side %d: backward error %.2e\n", diagonal, k, backwardError);
+      EXPECT_LT(backwardError, 1e-15) << "diagonal " << diagonal << ", right-hand side " << k;
+    }
+  }
 }
 
 // The condensed solver describes what factorised its last system, which run summaries read when
