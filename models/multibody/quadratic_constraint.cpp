@@ -163,12 +163,13 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
       if (positionTangent) K(lambda, lambda) = K(mu, mu) = args.alpha;
       continue;
     }
-    r[lambda] = phi;
-    r[mu] = 0.0;
+    double rateOfPhi = 0.0;  // grad Phi . v
     for (std::size_t s = 0; s < support.size(); ++s) {
       r[support[s]] += muValue * supportGradient[s];
-      r[mu] += supportGradient[s] * v[support[s]];
+      rateOfPhi += supportGradient[s] * v[support[s]];
     }
+    r[lambda] = phi;
+    r[mu] = rateOfPhi;
     // every multiplier entry of the tangent is alpha times a derivative (none in IDA's residual calls)
     if (!positionTangent) continue;
     form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
