@@ -5,51 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 
 namespace mpx {
 
 namespace {
-// Backtracking gives up (and the step is cut back) below this fraction of a Newton step.
-constexpr double kSmallestLineSearchStep = 1.0 / 1024;
-// Simplified Newton keeps a factorisation across step-size changes up to this fraction (the
-// contraction check refreshes it when the old step's tangent no longer contracts well).
-constexpr double kReusableStepChange = 0.2;
-// Newton goes on with the factorisation in hand while its correction is at most this fraction
-// of the increment before it: a fresh factorisation costs several residuals.
-constexpr double kHeldContraction = 0.003;
-// A factorisation held over more than one correction contracts linearly, not quadratically: its
-// last increment must be this fraction of the increment tolerance to leave the iterate as close
-// to the solution as a Newton step within the tolerance does (the two thermo-springs' eem4
-// balance per step stays at 6e-15; within the tolerance alone it reached 1.3e-14).
-constexpr double kHeldOverTolerance = 0.1;
-
-// After a Newton correction within kRoundOffBand^2 times the increment tolerance (1e-8), the
-// correction from the same factorisation at the next iterate is the last one up to kRoundOffBand
-// times the tolerance: as a correction it leaves an error of the order of the product of the two
-// (1e-17 relative), and as round-off no further correction removes it. eem4's stage gradients
-// divide psi's change over a step by the stage rates, so their residual carries up to 1e-11
-// relative round-off where the arguments barely move (engine/core/stage_gradient.hpp), and
-// corrections there wander at 1e-10-3e-10, around the tolerance: the two thermo-springs from
-// t = 8000 to 16000 took up to 5 iterations and 4 factorisations per step instead of 2 and 1.
-constexpr double kRoundOffBand = 10.0;
-
-// What the correction from the factorisation in hand is worth once the residual passes its test
-// (a fresh factorisation costs several residuals, so it is tried first). A correction within the
-// increment tolerance is the last, and so is one within kRoundOffBand of it from a factorisation
-// made at the iterate before, after a correction within kRoundOffBand^2 of it; one that
-// contracts by kHeldContraction on the increment before it is applied too, and the next
-// correction comes from the same factorisation (held over), which from then on must contract by
-// as much to be kept. Otherwise the factorisation is refreshed.
-enum class HeldCorrection { Refresh, Held, Last };
-HeldCorrection judgeHeldCorrection(double heldNorm, double incrementNorm, double tolerance, bool heldOver,
-                                   bool factorisedAtPrevious) {
-  if ((!heldOver && heldNorm <= tolerance) || (factorisedAtPrevious && heldNorm <= kRoundOffBand * tolerance &&
-                                               incrementNorm <= kRoundOffBand * kRoundOffBand * tolerance))
-    return HeldCorrection::Last;
-  return heldNorm <= kHeldContraction * incrementNorm ? HeldCorrection::Held : HeldCorrection::Refresh;
-}
-
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
   if (scheme == Scheme::Eem) return Component::LocalForm::Step;
@@ -160,126 +119,6 @@ void Integrator::endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd&
   for (int l = 0; l < rule_.stages; ++l) zEnd += rule_.end[l + 1] * (stages.segment(l * n, n) - zOld);
 }
 
-bool Integrator::solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew,
-                               StepOutcome& outcome) {
-  // a failure names the component and dof whose residual went non-finite in this step, if any
-  assembler_.forgetNonFinite();
-  auto fail = [&](const char* what, int iteration, double incrementNorm, double residualNorm) {
-    char note[200] = "";
-    if (assembler_.describeNonFinite(model_, note + 2, sizeof note - 2) > 0) note[0] = ';', note[1] = ' ';
-    std::snprintf(outcome.failure, sizeof outcome.failure, "%s (Newton iteration %d, increment %.3g, residual %.3g%s)",
-                  what, iteration, incrementNorm, residualNorm, note);
-    return false;
-  };
-  // Simplified Newton's iterates need the residual alone while the factorisation is kept; the
-  // tangent is evaluated where it is factorised.
-  const bool simplified = settings_.reuseContraction > 0.0;
-  // Full Newton: where the last solve needed a single factorisation, the first iterate is
-  // probably the last to need a tangent (the next correction comes from the factorisation in
-  // hand), so its trial evaluates the residual alone; the tangent follows if it is needed after all
-  const bool tangentLikelyDone = oneFactorisationSufficed_;
-  const int factorisationsBefore = outcome.factorizations;
-  bool refresh = !simplified || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
-  // a factorisation kept from an earlier step turns with the scene to this step's start
-  if (!refresh && settings_.corotate) corotation_.follow(zOld);
-  bool tangentAtIterate = refresh;
-  // the residual norm relative to row scales taken from the tangent at the current iterate
-  // (after a residual-only evaluation, from the last tangent evaluated)
-  auto rescaledNorm = [&](Assembler& system) {
-    stateScale_ = zNew.cwiseAbs() + unknownScale_;
-    if (tangentAtIterate) system.updateRowScale(stateScale_);
-    return system.relativeResidualNorm();
-  };
-
-  // a predictor whose residual is not finite is no start: begin from the old state
-  Assembler& system = evaluate(zOld, zNew, t, dt, tangentAtIterate);
-  double residualNorm = rescaledNorm(system);
-  if (!std::isfinite(residualNorm)) {
-    zNew = zOld.replicate(rule_.stages, 1);
-    evaluate(zOld, zNew, t, dt, tangentAtIterate);
-    residualNorm = rescaledNorm(system);
-  }
-  double incrementNorm = INFINITY;
-  // whether the factorisation in hand has given a correction beyond the tolerance since it was made
-  bool heldOver = false;
-  // whether the factorisation in hand is of the tangent at the iterate before the current one,
-  // and whether the correction just applied was taken as the last
-  bool factorisedAtPrevious = false, lastApplied = false;
-  if (!std::isfinite(residualNorm)) return fail("non-finite residual at the start of the step", 0, 0.0, residualNorm);
-  for (int iteration = 0;; ++iteration) {
-    const double incrementTolerance = (heldOver ? kHeldOverTolerance : 1.0) * settings_.incrementTolerance;
-    if (iteration > 0 && (incrementNorm <= incrementTolerance || lastApplied) &&
-        residualNorm <= settings_.residualTolerance) {
-      oneFactorisationSufficed_ = outcome.factorizations - factorisationsBefore == 1;
-      outcome.energy += system.flows() * dt;
-      if (byComponent_)
-        for (std::size_t c = 0; c < byComponent_->size(); ++c) (*byComponent_)[c] += system.componentFlows()[c] * dt;
-      return true;
-    }
-    if (iteration == settings_.maxIterations)
-      return fail("Newton did not converge", iteration, incrementNorm, residualNorm);
-    // once the residual passes its test, the factorisation in hand may give the next correction
-    // (judgeHeldCorrection), which is then applied with a residual-only evaluation
-    bool held = false, last = false;
-    if (refresh && iteration > 0 && residualNorm <= settings_.residualTolerance) {
-      correct(system.residual());
-      const HeldCorrection worth = judgeHeldCorrection(relativeNorm(increment_, zNew), incrementNorm,
-                                                       settings_.incrementTolerance, heldOver, factorisedAtPrevious);
-      last = worth == HeldCorrection::Last;
-      held = worth != HeldCorrection::Refresh;
-      heldOver = heldOver || worth == HeldCorrection::Held;
-      refresh = !held;
-    }
-    // backtrack along the Newton direction until the residual is finite and decreases (a
-    // full step near the solution, where the residual is already at round-off level); if no
-    // step decreases it, a kept factorisation is refreshed, then the reused pivots are
-    // replaced, before the step counts as failed
-    double step = 1.0;
-    bool tangentAtTrial = false;
-    for (bool repivot = false;;) {
-      if (refresh && !tangentAtIterate) {
-        tangentAtIterate = true;
-        evaluate(zOld, zNew, t, dt);
-        residualNorm = rescaledNorm(system);
-      }
-      if (refresh && !refactorize(zOld, dt, repivot, outcome))
-        return fail("singular tangent", iteration, incrementNorm, residualNorm);
-      heldOver = heldOver && !refresh;
-      if (!held) correct(system.residual());
-      tangentAtTrial = !simplified && !held && !(iteration == 0 && tangentLikelyDone);
-      step = lineSearch(zOld, t, dt, zNew, residualNorm, tangentAtTrial);
-      if (step > 0.0) break;
-      if (refresh && repivot)
-        return fail("no decrease of the residual along the Newton direction", iteration, incrementNorm, residualNorm);
-      repivot = refresh;
-      refresh = true;
-      held = last = false;
-      tangentAtIterate = false;  // the trials replaced the evaluation at zNew
-    }
-    zNew.swap(trial_);
-    tangentAtIterate = tangentAtTrial;
-    ++outcome.iterations;
-    const double previousIncrementNorm = incrementNorm;
-    incrementNorm = step * relativeNorm(increment_, zNew);
-    residualNorm = rescaledNorm(system);
-    // (a factorisation of the tangent's symmetric part contracts linearly even when fresh)
-    factorisedAtPrevious = refresh && !held && step == 1.0 && solver_.factorisesTheTangent();
-    lastApplied = last;
-    // keep the factorisation while the iteration contracts well (or has converged); full Newton
-    // keeps it too once the increment is small: a tangent taken that close to the solution
-    // contracts the next increment about as much as a fresh one (by about its own size)
-    const bool closeEnough = incrementNorm <= settings_.reuseBelowIncrement;
-    refresh = settings_.reuseContraction <= 0.0
-                  ? !closeEnough
-                  : incrementNorm > settings_.incrementTolerance &&
-                        !(incrementNorm <= settings_.reuseContraction * previousIncrementNorm);
-  }
-}
-
-double Integrator::relativeNorm(const Eigen::VectorXd& increment, const Eigen::VectorXd& z) const {
-  return (increment.array().abs() / (z.array().abs() + incrementScale_.array())).maxCoeff();
-}
-
 bool Integrator::continuesLastStep(const Eigen::VectorXd& z, double t) const {
   return pastCount_ >= 2 && std::abs(t - pastTimes_[0]) <= 1e-12 * (std::abs(t) + pastTimes_[0] - pastTimes_[1]) &&
          z == pastStates_[0];
@@ -347,32 +186,6 @@ void Integrator::choosePredictorDegree(double time, const Eigen::VectorXd& reach
   for (int part : {kVelocities, kRestOfState})
     for (int k = 2; k <= highest; ++k)
       if (miss[part][k] < miss[part][predictorDegree_[part]]) predictorDegree_[part] = k;
-}
-
-bool Integrator::refactorize(const Eigen::VectorXd& zOld, double dt, bool repivot, StepOutcome& outcome) {
-  factorizedDt_ = 0.0;
-  ++outcome.factorizations;
-  if (!solver_.factorize(assembler_.tangent(), repivot)) return false;
-  factorizedDt_ = dt;
-  corotation_.anchor(zOld);
-  return true;
-}
-
-void Integrator::correct(const Eigen::VectorXd& residual) {
-  corotation_.solve(solver_, residual, turnedResidual_, increment_);
-}
-
-double Integrator::lineSearch(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
-                              double residualNorm, bool tangent) {
-  for (double step = 1.0; step >= kSmallestLineSearchStep; step *= 0.5) {
-    trial_ = zNew + step * increment_;
-    evaluate(zOld, trial_, t, dt, tangent);
-    const double trialNorm = assembler_.relativeResidualNorm();
-    if (trialNorm <= (1.0 - 1e-4 * step) * residualNorm ||
-        (std::isfinite(trialNorm) && residualNorm <= settings_.residualTolerance))
-      return step;
-  }
-  return 0.0;
 }
 
 bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,

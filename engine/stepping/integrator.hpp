@@ -111,7 +111,48 @@ class Integrator {
   // the state it reached (in the increment test's norm) predicts the next step, chosen for the
   // velocities and for the rest of the state apart.
   void choosePredictorDegree(double time, const Eigen::VectorXd& reached);
+
+  // Newton on the step's unknowns (engine/stepping/newton.cpp), from the guess in `unknowns`.
   bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
+  // What the correction from the factorisation in hand is worth once the residual passes its
+  // test: none, one after which the next comes from the same factorisation, or the last.
+  enum class HeldCorrection { None, Held, Last };
+  // What one Newton solve carries from one iteration to the next.
+  struct NewtonProgress {
+    int iteration = 0;
+    double residualNorm = INFINITY;              // relative, at the iterate
+    double incrementNorm = INFINITY;             // of the correction that reached the iterate
+    bool tangentAtTrials = true;                 // full Newton: line-search trials assemble the tangent
+    bool firstTrialResidualOnly = false;         // the first iteration's trials do not (the last solve factorised once)
+    bool refresh = true;                         // the next correction needs a fresh factorisation
+    bool tangentAtIterate = true;                // the evaluation at the iterate assembled its tangent
+    bool tangentAtTrial = false;                 // the accepted trial's evaluation did
+    bool heldOver = false;                       // a held correction went beyond the tolerance since the factorisation
+    bool factorisedAtPrevious = false;           // the factorisation in hand is of the tangent at the iterate before
+    bool lastApplied = false;                    // the correction that reached the iterate was taken as the last
+    HeldCorrection held = HeldCorrection::None;  // this iteration's correction, if held
+  };
+  // Evaluate at the guess in zNew (at the old state where the guess's residual is not finite),
+  // with the tangent where a fresh factorisation is due.
+  NewtonProgress startNewton(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& zNew);
+  // The residual norm relative to row scales taken from the tangent at zNew (after a
+  // residual-only evaluation, from the last tangent evaluated).
+  double rescaledResidualNorm(const Eigen::VectorXd& zNew, bool tangentAtIterate);
+  bool newtonConverged(const NewtonProgress& progress) const;
+  HeldCorrection judgeHeldCorrection(double heldNorm, const NewtonProgress& progress) const;
+  // Once the residual passes its test, a due refresh waits: the correction from the factorisation
+  // in hand is computed and judged first.
+  void holdCorrection(const Eigen::VectorXd& zNew, NewtonProgress& progress);
+  // Correct zNew (from a fresh factorisation where one is due) and backtrack along the correction
+  // until the residual is finite and decreases (a full step near the solution, where the residual
+  // is already at round-off level); if no step decreases it, a kept factorisation is refreshed,
+  // then the reused pivots are replaced. The step taken, or 0 and the failure's reason.
+  double searchAlongCorrection(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
+                               NewtonProgress& progress, StepOutcome& outcome, const char*& failure);
+  // Move zNew to the accepted trial and decide whether the next correction needs a refresh.
+  void acceptTrial(double step, Eigen::VectorXd& zNew, NewtonProgress& progress);
+  // Record `what` failed, where, and which component's residual went non-finite, if any; false.
+  bool failNewton(const char* what, const NewtonProgress& progress, StepOutcome& outcome);
   // eem4: the stage rates and the end state of the stage polynomial, then its residual.
   void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
   // z(t + dt) of the stage polynomial.
