@@ -43,7 +43,7 @@ struct NewtonSettings {
   // Full Newton keeps its factorisation for the next iteration once the relative increment is
   // below this (0, the default: a fresh factorisation at every iteration whose residual has
   // not passed its test, and none while the factorisation in hand contracts the correction by
-  // 0.003 or brings it within the tolerance; integrator.cpp). At 1e-4 the
+  // 0.003 or brings it within the tolerance; newton.cpp). At 1e-4 the
   // iterations stay the same in number and a fifth of the factorisations go on the L-block,
   // but the last iterate is less converged than after a fresh Newton step, and the stiff
   // thermal chain's energy balance ends at 1.6e-12 instead of 3e-14 (docs/performance.md).
