@@ -113,13 +113,13 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 // scenes/lblock_thermoelastic.xml (same elastic constants, so only the thermal part differs).
 enum class LBlockVariant { Elastic, Viscoelastic, Thermoelastic };
 // Full Newton (a factorisation per iteration), or the simplified Newton the L-block scenes of
-// scenes/ ask for (<solver reuse_contraction="0.5"/>), with the tangent's LU or, on large
+// scenes/ ask for (<solver reuse_contraction="0.25"/>), with the tangent's LU or, on large
 // systems, the Cholesky factor of its symmetric part (<solver symmetric_factorisation>).
 enum class LBlockNewton { Full, Simplified, SimplifiedSymmetric };
 
 SceneSpec lblock(int level, LBlockVariant variant, double dt, LBlockNewton newton) {
   SceneSpec scene = generatedScene("lblock", dt, 50);
-  if (newton != LBlockNewton::Full) scene.settings.newton.reuseContraction = 0.5;
+  if (newton != LBlockNewton::Full) scene.settings.newton.reuseContraction = 0.25;
   scene.settings.newton.symmetricFactorisation = newton == LBlockNewton::SimplifiedSymmetric;
   ElementSpec& block = scene.add("solid", {{"name", "block"},
                                            {"mesh", "lblock"},
