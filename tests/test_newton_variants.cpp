@@ -1,4 +1,4 @@
-// Newton variants (engine/stepping/integrator): the predictor (start from the extrapolation of
+// Newton variants (engine/stepping/integrator.cpp, newton.cpp): the predictor (start from the extrapolation of
 // the last states), simplified Newton (a factorisation kept while the increments contract)
 // and full Newton that keeps its factorisation close to the solution change how the step's
 // equations are solved, never which equations: each run reaches the full-Newton solution to

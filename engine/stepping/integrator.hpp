@@ -97,6 +97,10 @@ class Integrator {
  private:
   // Midpoint or trapezoidal residual of the step from the components' rate form.
   void addRateForm(const Eigen::VectorXd& zOld, const Eigen::VectorXd& zNew, double t, double dt, bool tangent);
+  // eem4: the stage rates and the end state of the stage polynomial, then its residual.
+  void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
+  // z(t + dt) of the stage polynomial.
+  void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
   bool advanceLevel(const Eigen::VectorXd& z, double t, double dt, int level, Eigen::VectorXd& zNew,
                     StepOutcome& outcome);
   // Newton from the initial guess in zNew (eem4: stages on the line from zOld to that guess,
@@ -112,7 +116,8 @@ class Integrator {
   // velocities and for the rest of the state apart.
   void choosePredictorDegree(double time, const Eigen::VectorXd& reached);
 
-  // Newton on the step's unknowns (engine/stepping/newton.cpp), from the guess in `unknowns`.
+  // Newton on the step's unknowns (engine/stepping/newton.cpp), from the guess in `unknowns`
+  // (zNew in the helpers below: the end state, or eem4's stage values).
   bool solveUnknowns(const Eigen::VectorXd& zOld, double t, double dt, Eigen::VectorXd& unknowns, StepOutcome& outcome);
   // What the correction from the factorisation in hand is worth once the residual passes its
   // test: none, one after which the next comes from the same factorisation, or the last.
@@ -122,7 +127,7 @@ class Integrator {
     int iteration = 0;
     double residualNorm = INFINITY;              // relative, at the iterate
     double incrementNorm = INFINITY;             // of the correction that reached the iterate
-    bool tangentAtTrials = true;                 // full Newton: line-search trials assemble the tangent
+    bool fullNewton = true;                      // not simplified: line-search trials assemble the tangent
     bool firstTrialResidualOnly = false;         // the first iteration's trials do not (the last solve factorised once)
     bool refresh = true;                         // the next correction needs a fresh factorisation
     bool tangentAtIterate = true;                // the evaluation at the iterate assembled its tangent
@@ -138,25 +143,26 @@ class Integrator {
   // The residual norm relative to row scales taken from the tangent at zNew (after a
   // residual-only evaluation, from the last tangent evaluated).
   double rescaledResidualNorm(const Eigen::VectorXd& zNew, bool tangentAtIterate);
+  // After an iteration: the increment within its tolerance (a tenth of it after a held-over
+  // correction) or taken as the last, and the residual within its tolerance.
   bool newtonConverged(const NewtonProgress& progress) const;
+  // What a correction of relative size heldNorm from the factorisation in hand is worth.
   HeldCorrection judgeHeldCorrection(double heldNorm, const NewtonProgress& progress) const;
-  // Once the residual passes its test, a due refresh waits: the correction from the factorisation
-  // in hand is computed and judged first.
+  // Before a due refresh, once the residual passes its test: the correction from the
+  // factorisation in hand is computed and judged, and `held` says whether it is applied (Held,
+  // Last) or the refresh goes ahead (None).
   void holdCorrection(const Eigen::VectorXd& zNew, NewtonProgress& progress);
-  // Correct zNew (from a fresh factorisation where one is due) and backtrack along the correction
-  // until the residual is finite and decreases (a full step near the solution, where the residual
-  // is already at round-off level); if no step decreases it, a kept factorisation is refreshed,
-  // then the reused pivots are replaced. The step taken, or 0 and the failure's reason.
+  // The correction (from a fresh factorisation where one is due, unless one is held), and a
+  // backtracking search along it from zNew until the residual is finite and decreases (a full
+  // step near the solution, where the residual is already at round-off level); if no step
+  // decreases it, a kept factorisation is refreshed, then the reused pivots are replaced. The
+  // step taken (the trial left in trial_), or 0 and the failure's reason.
   double searchAlongCorrection(const Eigen::VectorXd& zOld, double t, double dt, const Eigen::VectorXd& zNew,
                                NewtonProgress& progress, StepOutcome& outcome, const char*& failure);
   // Move zNew to the accepted trial and decide whether the next correction needs a refresh.
   void acceptTrial(double step, Eigen::VectorXd& zNew, NewtonProgress& progress);
   // Record `what` failed, where, and which component's residual went non-finite, if any; false.
   bool failNewton(const char* what, const NewtonProgress& progress, StepOutcome& outcome);
-  // eem4: the stage rates and the end state of the stage polynomial, then its residual.
-  void addStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, double t, double dt, bool tangent);
-  // z(t + dt) of the stage polynomial.
-  void endOfStages(const Eigen::VectorXd& zOld, const Eigen::VectorXd& stages, Eigen::VectorXd& zEnd) const;
   // Factorise the tangent of the last evaluation that assembled one, for the step from zOld;
   // false if singular.
   bool refactorize(const Eigen::VectorXd& zOld, double dt, bool repivot, StepOutcome& outcome);

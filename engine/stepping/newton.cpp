@@ -82,12 +82,12 @@ Integrator::NewtonProgress Integrator::startNewton(const Eigen::VectorXd& zOld, 
   NewtonProgress progress;
   // Simplified Newton's iterates need the residual alone while the factorisation is kept; the
   // tangent is evaluated where it is factorised.
-  progress.tangentAtTrials = settings_.reuseContraction <= 0.0;
+  progress.fullNewton = settings_.reuseContraction <= 0.0;
   // Full Newton: where the last solve needed a single factorisation, the first iterate is
   // probably the last to need a tangent (the next correction comes from the factorisation in
   // hand), so its trial evaluates the residual alone; the tangent follows if it is needed after all
   progress.firstTrialResidualOnly = oneFactorisationSufficed_;
-  progress.refresh = progress.tangentAtTrials || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
+  progress.refresh = progress.fullNewton || !(std::abs(dt - factorizedDt_) <= kReusableStepChange * factorizedDt_);
   // a factorisation kept from an earlier step turns with the scene to this step's start
   if (!progress.refresh && settings_.corotate) corotation_.follow(zOld);
   progress.tangentAtIterate = progress.refresh;
@@ -137,7 +137,7 @@ double Integrator::searchAlongCorrection(const Eigen::VectorXd& zOld, double t, 
     }
     progress.heldOver = progress.heldOver && !progress.refresh;
     if (progress.held == HeldCorrection::None) correct(assembler_.residual());
-    progress.tangentAtTrial = progress.tangentAtTrials && progress.held == HeldCorrection::None &&
+    progress.tangentAtTrial = progress.fullNewton && progress.held == HeldCorrection::None &&
                               !(progress.iteration == 0 && progress.firstTrialResidualOnly);
     const double step = lineSearch(zOld, t, dt, zNew, progress.residualNorm, progress.tangentAtTrial);
     if (step > 0.0) return step;
@@ -154,13 +154,15 @@ double Integrator::searchAlongCorrection(const Eigen::VectorXd& zOld, double t, 
 
 void Integrator::acceptTrial(double step, Eigen::VectorXd& zNew, NewtonProgress& progress) {
   zNew.swap(trial_);
+  const bool factorisedNow = progress.refresh;
   progress.tangentAtIterate = progress.tangentAtTrial;
   const double previousIncrementNorm = progress.incrementNorm;
   progress.incrementNorm = step * relativeNorm(increment_, zNew);
   progress.residualNorm = rescaledResidualNorm(zNew, progress.tangentAtIterate);
   // (a factorisation of the tangent's symmetric part contracts linearly even when fresh; a held
-  // correction never comes with a refresh)
-  progress.factorisedAtPrevious = progress.refresh && step == 1.0 && solver_.factorisesTheTangent();
+  // correction never comes with a refresh: holdCorrection sets refresh = (held == None), and a
+  // retried search resets both)
+  progress.factorisedAtPrevious = factorisedNow && step == 1.0 && solver_.factorisesTheTangent();
   progress.lastApplied = progress.held == HeldCorrection::Last;
   // keep the factorisation while the iteration contracts well (or has converged); full Newton
   // keeps it too once the increment is small: a tangent taken that close to the solution
