@@ -1,5 +1,7 @@
 #include "models/multibody/quadratic_constraint.hpp"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -97,21 +99,20 @@ void QuadraticConstraint::eemLocal(const StepArgs& args, Workspace&, LocalSystem
   auto K = out.tangent();
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const std::vector<int>& support = form.supportCoordinates();
+    const int supportSize = static_cast<int>(form.supportCoordinates().size());
     // exact discrete gradient of lambda Phi + kappa/2 Phi^2 for a quadratic Phi: the gradient at
     // the midpoint, the mean of the end points' (two products with H, not three)
     SupportValues gradientStart, gradientEnd, gradientMid;
     const double phiStart = form.valueAndSupportGradient(q0, gradientStart);
     const double phiEnd = form.valueAndSupportGradient(q1, gradientEnd);
     const double force = multiplier(args.zNew, k) + 0.5 * spec_.stiffness * (phiStart + phiEnd);
-    for (std::size_t s = 0; s < support.size(); ++s) {
-      gradientMid[s] = 0.5 * (gradientStart[s] + gradientEnd[s]);
-      r[n + support[s]] += force * gradientMid[s];
-    }
+    for (int s = 0; s < supportSize; ++s) gradientMid[s] = 0.5 * (gradientStart[s] + gradientEnd[s]);
+    form.addOnSupport(force, gradientMid, r.segment(n, n));
     // the tangent takes the gradients whole
-    const ConstraintVector wholeMid = args.tangent ? form.fromSupport(gradientMid, n) : ConstraintVector();
-    const ConstraintVector wholeEnd = args.tangent ? form.fromSupport(gradientEnd, n) : ConstraintVector();
+    ConstraintVector wholeMid, wholeEnd;
     if (args.tangent) {
+      wholeMid = form.fromSupport(gradientMid);
+      wholeEnd = form.fromSupport(gradientEnd);
       K.block(n, 0, n, n).noalias() += (0.5 * spec_.stiffness) * wholeMid * wholeEnd.transpose();
       form.addHessian(0.5 * force, K.block(n, 0, n, n));
     }
@@ -142,12 +143,11 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
   const bool positionTangent = args.alpha != 0.0;
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const std::vector<int>& support = form.supportCoordinates();
     SupportValues supportGradient;
     const double phi = form.valueAndSupportGradient(q, supportGradient);
     const double force = multiplier(args.z, k) + spec_.stiffness * phi;
-    for (std::size_t s = 0; s < support.size(); ++s) r[n + support[s]] += force * supportGradient[s];
-    const ConstraintVector gradient = positionTangent ? form.fromSupport(supportGradient, n) : ConstraintVector();
+    form.addOnSupport(force, supportGradient, r.segment(n, n));
+    const ConstraintVector gradient = positionTangent ? form.fromSupport(supportGradient) : ConstraintVector();
     if (positionTangent) {
       K.block(n, 0, n, n).noalias() += (args.alpha * spec_.stiffness) * gradient * gradient.transpose();
       form.addHessian(args.alpha * force, K.block(n, 0, n, n));
@@ -163,13 +163,9 @@ void QuadraticConstraint::rateLocal(const RateArgs& args, Workspace&, LocalSyste
       if (positionTangent) K(lambda, lambda) = K(mu, mu) = args.alpha;
       continue;
     }
-    double rateOfPhi = 0.0;  // grad Phi . v
-    for (std::size_t s = 0; s < support.size(); ++s) {
-      r[support[s]] += muValue * supportGradient[s];
-      rateOfPhi += supportGradient[s] * v[support[s]];
-    }
+    form.addOnSupport(muValue, supportGradient, r.segment(0, n));
     r[lambda] = phi;
-    r[mu] = rateOfPhi;
+    r[mu] = form.dotOnSupport(supportGradient, v);  // grad Phi . v
     // every multiplier entry of the tangent is alpha times a derivative (none in IDA's residual calls)
     if (!positionTangent) continue;
     form.addHessian(args.alpha * muValue, K.block(0, 0, n, n));
@@ -192,6 +188,7 @@ void QuadraticConstraint::stageResiduals(const StageArgs& args, Workspace&, Loca
 void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const {
   const CollocationRule& rule = *args.rule;
   const int column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  assert(!args.tangent || count == 1);  // the tangent's sums below serve one stage
   // the basis points of the step's polynomial (the start, then each stage), and the positions
   // and their tau-rates at the points of the fine rule, which every form and stage share
   ConstraintVector basis[CollocationRule::kMostStages + 1];
@@ -208,10 +205,9 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
   }
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
-    const std::vector<int>& support = form.supportCoordinates();
-    const bool held = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
+    const bool lambdaUnknown = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
     double lambda[CollocationRule::kMostStages] = {};
-    if (held)
+    if (lambdaUnknown)
       for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
     // Galerkin projections onto each stage's test function, exact for these polynomial
     // integrands: the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
@@ -234,20 +230,18 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       SupportValues supportGradient;
       const double phi = form.valueAndSupportGradient(q, supportGradient);
       const double value = multiplier + spec_.stiffness * phi;
-      double rateOfPhiHere = 0.0;
-      if (held)
-        for (std::size_t s = 0; s < support.size(); ++s) rateOfPhiHere += supportGradient[s] * rate[support[s]];
-      const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient, n) : ConstraintVector();
+      const double rateOfPhiHere = lambdaUnknown ? form.dotOnSupport(supportGradient, rate) : 0.0;
+      const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient) : ConstraintVector();
       for (int i = 0; i < count; ++i) {
         const int l = firstStage + i;
         const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
-        for (std::size_t s = 0; s < support.size(); ++s) force[i][support[s]] += (test * value) * supportGradient[s];
+        form.addOnSupport(test * value, supportGradient, force[i]);
         rateOfPhi[i] += test * rateOfPhiHere;
         if (!args.tangent) continue;
         const double valueCoefficient = rule.fineValue[p][column + 1];
         hessianWeight += test * valueCoefficient * value;
         dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
-        if (!held) continue;
+        if (!lambdaUnknown) continue;
         dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
         rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
       }
@@ -268,7 +262,7 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
       r[mu] = z[spec_.firstMultiplierDof + m + k];
       if (own) K(mu, mu) = 1.0;
-      if (!held) {
+      if (!lambdaUnknown) {
         r[lambdaRow] = z[spec_.firstMultiplierDof + k];
         if (own) K(lambdaRow, lambdaRow) = 1.0;
         continue;

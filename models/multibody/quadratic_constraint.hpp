@@ -4,8 +4,8 @@
 // in the director formulation (docs/theory.md sections 6-7). For a quadratic Phi the discrete
 // gradient of V = lambda Phi + kappa/2 Phi^2 is exact:
 //   D V = (lambda + kappa (Phi(q) + Phi(q'))/2) grad Phi(q_mid),
-// so constraint forces do no spurious work. Penalty: lambda = 0. Augmented Lagrangian: one
-// multiplier dof per constraint, solved by Newton together with the positions from the row
+// so constraint forces do no spurious work. Penalty: lambda = 0. Augmented Lagrangian: a
+// multiplier lambda per constraint, solved by Newton together with the positions from the row
 // Phi(q') = 0, so the constraint holds at every step to Newton's tolerance and the energy
 // (which includes lambda Phi) is exact; kappa regularises the saddle point. The rate form
 // (midpoint, trapezoidal, IDA) is the stabilised index-2 GGL form with a second multiplier mu
@@ -47,7 +47,6 @@ class QuadraticConstraint final : public Component {
   // out of the saddle point, which would otherwise be singular. Its penalty part stays, and
   // Phi_k is still measured.
   void holdMultipliersAtZero(std::size_t k) { implied_.at(k) = true; }
-  bool multipliersHeldAtZero(std::size_t k) const { return implied_[k]; }
 
   void measure(const double* z, Measures& out) const override;
   // augmented Lagrangian with a leading gap (none of it implied): its lambdas and mus are forces

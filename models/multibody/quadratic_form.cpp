@@ -33,8 +33,8 @@ double QuadraticForm::valueAndSupportGradient(const ConstraintVector& q, Support
   return 0.5 * twiceQuadratic + constant_;
 }
 
-ConstraintVector QuadraticForm::fromSupport(const SupportValues& values, int size) const {
-  ConstraintVector full = ConstraintVector::Zero(size);
+ConstraintVector QuadraticForm::fromSupport(const SupportValues& values) const {
+  ConstraintVector full = ConstraintVector::Zero(gradient_.size());
   for (std::size_t s = 0; s < supportCoordinates_.size(); ++s) full[supportCoordinates_[s]] = values[s];
   return full;
 }

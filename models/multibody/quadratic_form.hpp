@@ -36,12 +36,24 @@ class QuadraticForm {
   }
   double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
   // phi(q), and grad phi(q) at the support coordinates only: the residual of a constraint works
-  // on the few coordinates a form touches instead of all 24
+  // on the few coordinates a form touches instead of all n (up to 24)
   double valueAndSupportGradient(const ConstraintVector& q, SupportValues& gradient) const;
   // The coordinates phi depends on, in increasing order.
   const std::vector<int>& supportCoordinates() const { return supportCoordinates_; }
-  // The full gradient from its support values.
-  ConstraintVector fromSupport(const SupportValues& values, int size) const;
+  // Support values as a vector of all n coordinates (zero off the support).
+  ConstraintVector fromSupport(const SupportValues& values) const;
+  // target[i] += factor values_i over the support coordinates i, for target (an expression of) a
+  // vector of all n coordinates
+  template <class Target>
+  void addOnSupport(double factor, const SupportValues& values, Target&& target) const {
+    for (std::size_t s = 0; s < supportCoordinates_.size(); ++s) target[supportCoordinates_[s]] += factor * values[s];
+  }
+  // sum over the support coordinates i of values_i v_i
+  double dotOnSupport(const SupportValues& values, const ConstraintVector& v) const {
+    double sum = 0.0;
+    for (std::size_t s = 0; s < supportCoordinates_.size(); ++s) sum += values[s] * v[supportCoordinates_[s]];
+    return sum;
+  }
   // Whether phi depends on coordinate i (its gradient's entry i can be non-zero).
   bool touches(int i) const { return support_ >> i & 1u; }
   // The coordinates phi depends on, and those H couples to coordinate i, as bit masks.
