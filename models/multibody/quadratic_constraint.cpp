@@ -203,6 +203,13 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       fineRate[p] += rule.fineRate[p][j] * basis[j];
     }
   }
+  // each stage's test function times the fine rule's weight, over the stage's Gauss weight
+  double testWeight[CollocationRule::kFinePoints][CollocationRule::kMostStages];
+  for (int p = 0; p < CollocationRule::kFinePoints; ++p)
+    for (int i = 0; i < count; ++i) {
+      const int l = firstStage + i;
+      testWeight[p][i] = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
+    }
   for (int k = 0; k < m; ++k) {
     const QuadraticForm& form = spec_.forms[k];
     const bool lambdaUnknown = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
@@ -210,10 +217,12 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
     if (lambdaUnknown)
       for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
     // Galerkin projections onto each stage's test function, exact for these polynomial
-    // integrands: the force (lambda + kappa Phi) grad Phi and, for lambda's row, the rate of Phi
-    ConstraintVector force[CollocationRule::kMostStages];
+    // integrands: the force (lambda + kappa Phi) grad Phi (on the form's support) and, for
+    // lambda's row, the rate of Phi
+    const int supportSize = static_cast<int>(form.supportCoordinates().size());
+    SupportValues force[CollocationRule::kMostStages];
     double rateOfPhi[CollocationRule::kMostStages] = {};
-    for (int i = 0; i < count; ++i) force[i] = ConstraintVector::Zero(n);
+    for (int i = 0; i < count; ++i) std::fill_n(force[i].begin(), supportSize, 0.0);
     // the tangent (one stage at a time): the n x n block, the Hessian's share of it summed over
     // the points before it multiplies H, lambda's column and row
     ConstraintMatrix dForce;
@@ -233,9 +242,8 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       const double rateOfPhiHere = lambdaUnknown ? form.dotOnSupport(supportGradient, rate) : 0.0;
       const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient) : ConstraintVector();
       for (int i = 0; i < count; ++i) {
-        const int l = firstStage + i;
-        const double test = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
-        form.addOnSupport(test * value, supportGradient, force[i]);
+        const double test = testWeight[p][i];
+        for (int s = 0; s < supportSize; ++s) force[i][s] += (test * value) * supportGradient[s];
         rateOfPhi[i] += test * rateOfPhiHere;
         if (!args.tangent) continue;
         const double valueCoefficient = rule.fineValue[p][column + 1];
@@ -252,7 +260,7 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       const double* z = args.stageState[l];
       auto r = out[i].residual();
       auto K = out[i].tangent();
-      r.segment(n, n) += force[i];
+      form.addOnSupport(1.0, force[i], r.segment(n, n));
       if (args.tangent) {
         K.block(n, 0, n, n) += dForce;
         form.addHessian(hessianWeight, K.block(n, 0, n, n));
@@ -272,9 +280,10 @@ void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int c
       // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
       // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
       if (l == 0) {
-        const ConstraintVector gradientEnd = form.gradientAt(qEnd);
-        r[lambdaRow] = form.valueAt(qEnd, gradientEnd);
-        if (args.tangent) K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * gradientEnd.transpose();
+        SupportValues gradientEnd;
+        r[lambdaRow] = form.valueAndSupportGradient(qEnd, gradientEnd);
+        if (args.tangent)
+          K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * form.fromSupport(gradientEnd).transpose();
       } else {
         r[lambdaRow] = rateOfPhi[i] / args.dt;
         if (args.tangent) K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;

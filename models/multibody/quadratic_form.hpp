@@ -30,11 +30,8 @@ class QuadraticForm {
   ConstraintVector hessianTimes(const ConstraintVector& v) const;
   // grad phi(q) = H q + g
   ConstraintVector gradientAt(const ConstraintVector& q) const { return hessianTimes(q) + gradient_; }
-  // phi(q); with grad phi(q) at hand, phi = q.(grad phi(q) + g)/2 + c
-  double valueAt(const ConstraintVector& q, const ConstraintVector& gradientAtQ) const {
-    return 0.5 * q.dot(gradientAtQ + gradient_) + constant_;
-  }
-  double valueAt(const ConstraintVector& q) const { return valueAt(q, gradientAt(q)); }
+  // phi(q) = q.(grad phi(q) + g)/2 + c
+  double valueAt(const ConstraintVector& q) const { return 0.5 * q.dot(gradientAt(q) + gradient_) + constant_; }
   // phi(q), and grad phi(q) at the support coordinates only: the residual of a constraint works
   // on the few coordinates a form touches instead of all n (up to 24)
   double valueAndSupportGradient(const ConstraintVector& q, SupportValues& gradient) const;
