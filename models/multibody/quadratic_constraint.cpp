@@ -73,7 +73,7 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
 }
 
 double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
-  return augmented() ? z[spec_.firstMultiplierDof + k] : 0.0;
+  return augmented() && !implied_[k] ? z[spec_.firstMultiplierDof + k] : 0.0;
 }
 
 void QuadraticConstraint::spatialVectors(std::vector<SpatialVector>& out) const {

@@ -63,7 +63,7 @@ class QuadraticConstraint final : public Component {
   static std::vector<int> collectDofs(const ConstraintSpec& spec);
   // The constrained positions (shift 0) or their velocities (shift = velocityShift) in z.
   ConstraintVector gather(const double* z, int shift) const;
-  // lambda_k (0 for penalty).
+  // lambda_k (0 for penalty and for an implied form, whose lambda is held at zero).
   double multiplier(const double* z, std::size_t k) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
   // The stage form for stages firstStage .. firstStage + count - 1 into out[0 .. count - 1]: the
