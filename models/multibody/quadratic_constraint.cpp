@@ -185,109 +185,135 @@ void QuadraticConstraint::stageResiduals(const StageArgs& args, Workspace&, Loca
   addStages(args, 0, args.rule->stages, out);
 }
 
+// The step's path at the points of the fine rule, which every form and stage share.
+struct QuadraticConstraint::StagePath {
+  ConstraintVector q[CollocationRule::kFinePoints], rate[CollocationRule::kFinePoints];  // positions, tau-rates
+  ConstraintVector end;                                                                  // positions at the step's end
+  // each stage's test function times the fine rule's weight, over the stage's Gauss weight
+  double testWeight[CollocationRule::kFinePoints][CollocationRule::kMostStages];
+};
+
+// One form's Galerkin projections onto the stages' test functions, exact for these polynomial
+// integrands: the force (lambda + kappa Phi) grad Phi (on the form's support) and, for lambda's
+// row, the rate of Phi; with a tangent (one stage at a time) the n x n block, the Hessian's share
+// of it summed over the points before it multiplies H, lambda's column and row.
+struct QuadraticConstraint::StageProjection {
+  bool lambdaUnknown = false;  // lambda_k is a stagewise linear unknown
+  SupportValues force[CollocationRule::kMostStages];
+  double rateOfPhi[CollocationRule::kMostStages] = {};
+  ConstraintMatrix dForce;
+  ConstraintVector dForceDLambda, rateRow;
+  double hessianWeight = 0.0;
+};
+
 void QuadraticConstraint::addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const {
+  assert(!args.tangent || count == 1);  // the projections' tangent sums serve one stage
+  const StagePath path = stagePath(args, firstStage, count);
+  for (std::size_t k = 0; k < spec_.forms.size(); ++k)
+    addFormRows(k, project(k, args, path, count), args, path, firstStage, count, out);
+}
+
+QuadraticConstraint::StagePath QuadraticConstraint::stagePath(const StageArgs& args, int firstStage, int count) const {
   const CollocationRule& rule = *args.rule;
-  const int column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
-  assert(!args.tangent || count == 1);  // the tangent's sums below serve one stage
-  // the basis points of the step's polynomial (the start, then each stage), and the positions
-  // and their tau-rates at the points of the fine rule, which every form and stage share
+  const int n = positionCount_;
+  StagePath path;
+  // the basis points of the step's polynomial: the start, then each stage
   ConstraintVector basis[CollocationRule::kMostStages + 1];
   basis[0] = gather(args.zOld, 0);
   for (int j = 0; j < rule.stages; ++j) basis[j + 1] = gather(args.stageState[j], 0);
-  const ConstraintVector qEnd = gather(args.zEnd, 0);
-  ConstraintVector fineQ[CollocationRule::kFinePoints], fineRate[CollocationRule::kFinePoints];
+  path.end = gather(args.zEnd, 0);
   for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
-    fineQ[p] = fineRate[p] = ConstraintVector::Zero(n);
+    path.q[p] = path.rate[p] = ConstraintVector::Zero(n);
     for (int j = 0; j <= rule.stages; ++j) {
-      fineQ[p] += rule.fineValue[p][j] * basis[j];
-      fineRate[p] += rule.fineRate[p][j] * basis[j];
+      path.q[p] += rule.fineValue[p][j] * basis[j];
+      path.rate[p] += rule.fineRate[p][j] * basis[j];
+    }
+    for (int i = 0; i < count; ++i) {
+      const int l = firstStage + i;
+      path.testWeight[p][i] = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
     }
   }
-  // each stage's test function times the fine rule's weight, over the stage's Gauss weight
-  double testWeight[CollocationRule::kFinePoints][CollocationRule::kMostStages];
-  for (int p = 0; p < CollocationRule::kFinePoints; ++p)
+  return path;
+}
+
+QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k, const StageArgs& args,
+                                                                  const StagePath& path, int count) const {
+  const CollocationRule& rule = *args.rule;
+  const int column = args.column, n = positionCount_;
+  const QuadraticForm& form = spec_.forms[k];
+  StageProjection out;
+  out.lambdaUnknown = augmented() && !implied_[k];
+  double lambda[CollocationRule::kMostStages] = {};
+  if (out.lambdaUnknown)
+    for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
+  const int supportSize = static_cast<int>(form.supportCoordinates().size());
+  for (int i = 0; i < count; ++i) std::fill_n(out.force[i].begin(), supportSize, 0.0);
+  if (args.tangent) {
+    out.dForce.setZero(n, n);
+    out.dForceDLambda = out.rateRow = ConstraintVector::Zero(n);
+  }
+  for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
+    const ConstraintVector &q = path.q[p], &rate = path.rate[p];
+    double multiplier = 0.0;
+    for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
+    SupportValues supportGradient;
+    const double phi = form.valueAndSupportGradient(q, supportGradient);
+    const double value = multiplier + spec_.stiffness * phi;
+    const double rateOfPhiHere = out.lambdaUnknown ? form.dotOnSupport(supportGradient, rate) : 0.0;
+    const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient) : ConstraintVector();
     for (int i = 0; i < count; ++i) {
-      const int l = firstStage + i;
-      testWeight[p][i] = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
+      const double test = path.testWeight[p][i];
+      for (int s = 0; s < supportSize; ++s) out.force[i][s] += (test * value) * supportGradient[s];
+      out.rateOfPhi[i] += test * rateOfPhiHere;
+      if (!args.tangent) continue;
+      const double valueCoefficient = rule.fineValue[p][column + 1];
+      out.hessianWeight += test * valueCoefficient * value;
+      out.dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
+      if (!out.lambdaUnknown) continue;
+      out.dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
+      out.rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
     }
-  for (int k = 0; k < m; ++k) {
-    const QuadraticForm& form = spec_.forms[k];
-    const bool lambdaUnknown = augmented() && !implied_[k];  // lambda_k is a stagewise linear unknown
-    double lambda[CollocationRule::kMostStages] = {};
-    if (lambdaUnknown)
-      for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
-    // Galerkin projections onto each stage's test function, exact for these polynomial
-    // integrands: the force (lambda + kappa Phi) grad Phi (on the form's support) and, for
-    // lambda's row, the rate of Phi
-    const int supportSize = static_cast<int>(form.supportCoordinates().size());
-    SupportValues force[CollocationRule::kMostStages];
-    double rateOfPhi[CollocationRule::kMostStages] = {};
-    for (int i = 0; i < count; ++i) std::fill_n(force[i].begin(), supportSize, 0.0);
-    // the tangent (one stage at a time): the n x n block, the Hessian's share of it summed over
-    // the points before it multiplies H, lambda's column and row
-    ConstraintMatrix dForce;
-    ConstraintVector dForceDLambda, rateRow;
-    double hessianWeight = 0.0;
+  }
+  return out;
+}
+
+void QuadraticConstraint::addFormRows(std::size_t k, const StageProjection& projection, const StageArgs& args,
+                                      const StagePath& path, int firstStage, int count, LocalSystem* out) const {
+  const CollocationRule& rule = *args.rule;
+  const int column = args.column, n = positionCount_, m = static_cast<int>(spec_.forms.size());
+  const QuadraticForm& form = spec_.forms[k];
+  for (int i = 0; i < count; ++i) {
+    const int l = firstStage + i;
+    const bool own = args.tangent && l == column;
+    const double* z = args.stageState[l];
+    auto r = out[i].residual();
+    auto K = out[i].tangent();
+    form.addOnSupport(1.0, projection.force[i], r.segment(n, n));
     if (args.tangent) {
-      dForce.setZero(n, n);
-      dForceDLambda = rateRow = ConstraintVector::Zero(n);
+      K.block(n, 0, n, n) += projection.dForce;
+      form.addHessian(projection.hessianWeight, K.block(n, 0, n, n));
     }
-    for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
-      const ConstraintVector &q = fineQ[p], &rate = fineRate[p];
-      double multiplier = 0.0;
-      for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-      SupportValues supportGradient;
-      const double phi = form.valueAndSupportGradient(q, supportGradient);
-      const double value = multiplier + spec_.stiffness * phi;
-      const double rateOfPhiHere = lambdaUnknown ? form.dotOnSupport(supportGradient, rate) : 0.0;
-      const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient) : ConstraintVector();
-      for (int i = 0; i < count; ++i) {
-        const double test = testWeight[p][i];
-        for (int s = 0; s < supportSize; ++s) force[i][s] += (test * value) * supportGradient[s];
-        rateOfPhi[i] += test * rateOfPhiHere;
-        if (!args.tangent) continue;
-        const double valueCoefficient = rule.fineValue[p][column + 1];
-        hessianWeight += test * valueCoefficient * value;
-        dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
-        if (!lambdaUnknown) continue;
-        dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-        rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
-      }
+    if (!augmented()) continue;
+    // mu is not used (mu = 0), nor lambda of an implied form
+    const int lambdaRow = 2 * n + static_cast<int>(k), mu = 2 * n + m + static_cast<int>(k);
+    r[mu] = z[spec_.firstMultiplierDof + m + k];
+    if (own) K(mu, mu) = 1.0;
+    if (!projection.lambdaUnknown) {
+      r[lambdaRow] = z[spec_.firstMultiplierDof + k];
+      if (own) K(lambdaRow, lambdaRow) = 1.0;
+      continue;
     }
-    for (int i = 0; i < count; ++i) {
-      const int l = firstStage + i;
-      const bool own = args.tangent && l == column;
-      const double* z = args.stageState[l];
-      auto r = out[i].residual();
-      auto K = out[i].tangent();
-      form.addOnSupport(1.0, force[i], r.segment(n, n));
-      if (args.tangent) {
-        K.block(n, 0, n, n) += dForce;
-        form.addHessian(hessianWeight, K.block(n, 0, n, n));
-      }
-      if (!augmented()) continue;
-      // mu is not used (mu = 0), nor lambda of an implied form
-      const int lambdaRow = 2 * n + k, mu = 2 * n + m + k;
-      r[mu] = z[spec_.firstMultiplierDof + m + k];
-      if (own) K(mu, mu) = 1.0;
-      if (!lambdaUnknown) {
-        r[lambdaRow] = z[spec_.firstMultiplierDof + k];
-        if (own) K(lambdaRow, lambdaRow) = 1.0;
-        continue;
-      }
-      if (args.tangent) K.block(n, lambdaRow, n, 1) += dForceDLambda;
-      // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
-      // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
-      // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
-      if (l == 0) {
-        SupportValues gradientEnd;
-        r[lambdaRow] = form.valueAndSupportGradient(qEnd, gradientEnd);
-        if (args.tangent)
-          K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * form.fromSupport(gradientEnd).transpose();
-      } else {
-        r[lambdaRow] = rateOfPhi[i] / args.dt;
-        if (args.tangent) K.block(lambdaRow, 0, 1, n) = rateRow.transpose() / args.dt;
-      }
+    if (args.tangent) K.block(n, lambdaRow, n, 1) += projection.dForceDLambda;
+    // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
+    // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
+    // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
+    if (l == 0) {
+      SupportValues gradientEnd;
+      r[lambdaRow] = form.valueAndSupportGradient(path.end, gradientEnd);
+      if (args.tangent) K.block(lambdaRow, 0, 1, n) = rule.end[column + 1] * form.fromSupport(gradientEnd).transpose();
+    } else {
+      r[lambdaRow] = projection.rateOfPhi[i] / args.dt;
+      if (args.tangent) K.block(lambdaRow, 0, 1, n) = projection.rateRow.transpose() / args.dt;
     }
   }
 }

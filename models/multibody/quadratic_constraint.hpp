@@ -69,6 +69,14 @@ class QuadraticConstraint final : public Component {
   // The stage form for stages firstStage .. firstStage + count - 1 into out[0 .. count - 1]: the
   // residuals, and with args.tangent (count 1) the derivative w.r.t. stage args.column.
   void addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const;
+  // addStages' parts: the step's path at the fine rule's points, form k's projections onto the
+  // stages' test functions along it, and form k's rows of those stages (see the .cpp).
+  struct StagePath;
+  struct StageProjection;
+  StagePath stagePath(const StageArgs& args, int firstStage, int count) const;
+  StageProjection project(std::size_t k, const StageArgs& args, const StagePath& path, int count) const;
+  void addFormRows(std::size_t k, const StageProjection& projection, const StageArgs& args, const StagePath& path,
+                   int firstStage, int count, LocalSystem* out) const;
   ConstraintSpec spec_;
   int positionCount_;
   std::vector<bool> implied_;  // per form: multipliers held at zero
