@@ -168,7 +168,7 @@ void Integrator::acceptTrial(double step, Eigen::VectorXd& zNew, NewtonProgress&
   // keeps it too once the increment is small: a tangent taken that close to the solution
   // contracts the next increment about as much as a fresh one (by about its own size)
   const bool closeEnough = progress.incrementNorm <= settings_.reuseBelowIncrement;
-  progress.refresh = settings_.reuseContraction <= 0.0
+  progress.refresh = progress.fullNewton
                          ? !closeEnough
                          : progress.incrementNorm > settings_.incrementTolerance &&
                                !(progress.incrementNorm <= settings_.reuseContraction * previousIncrementNorm);
