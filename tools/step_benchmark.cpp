@@ -112,8 +112,8 @@ SceneSpec rigidChain(int links, Enforcement enforcement, double stiffness, doubl
 // of scenes/lblock_viscoelastic.xml, Thermoelastic the thermal field of
 // scenes/lblock_thermoelastic.xml (same elastic constants, so only the thermal part differs).
 enum class LBlockVariant { Elastic, Viscoelastic, Thermoelastic };
-// Full Newton (a factorisation per iteration), or the simplified Newton the L-block scenes of
-// scenes/ ask for (<solver reuse_contraction="0.25"/>), with the tangent's LU or, on large
+// Full Newton (a factorisation per iteration), or the simplified Newton the elastic and
+// viscoelastic L-block scenes ask for (<solver reuse_contraction="0.25"/>), with the tangent's LU or, on large
 // systems, the Cholesky factor of its symmetric part (<solver symmetric_factorisation>).
 enum class LBlockNewton { Full, Simplified, SimplifiedSymmetric };
 
