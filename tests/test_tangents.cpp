@@ -375,21 +375,39 @@ TEST(RateTangent, MatchesSeparateFiniteDifferencesInStateAndRate) {
 
 // A constraint or invariant form keeps only its Hessian's nonzeros: its value, gradient and
 // Hessian equal those of the dense quadratic it was built from (a symmetric H with zero rows and
-// columns, as a joint condition touches few of the 24 coordinates), and the gradient and
-// Hessian are central differences of the value and gradient (exact for a quadratic).
+// columns, as a joint condition touches few of the 24 coordinates), its support is the
+// coordinates a row of H or g reaches and its values on the support are the whole gradient's,
+// and the gradient and Hessian are central differences of the value and gradient (exact for a
+// quadratic).
 TEST(QuadraticFormTangent, MatchesTheDenseFormAndItsFiniteDifferences) {
   constexpr int n = 12;
   ConstraintMatrix H = ConstraintMatrix::Zero(n, n);
   const VectorXd entries = randomIsh(VectorXd::Ones(n * n), 17);
   for (int i = 0; i < n; i += 2)
     for (int j = 0; j <= i; j += 3) H(i, j) = H(j, i) = entries[i * n + j];
-  const ConstraintVector g = randomIsh(VectorXd::Ones(n), 19);
+  // g zero where H's rows are (1, 5, 7 and 11), so that the support leaves those out
+  ConstraintVector g = randomIsh(VectorXd::Ones(n), 19);
+  for (int i = 0; i < n; ++i)
+    if (H.row(i).isZero()) g[i] = 0.0;
   const double c = 0.3;
   const QuadraticForm form(H, g, c);
   const ConstraintVector q = randomIsh(VectorXd::Ones(n), 23);
 
   EXPECT_NEAR(form.valueAt(q), 0.5 * q.dot(H * q) + g.dot(q) + c, 1e-14);
   EXPECT_LT((form.gradientAt(q) - (H * q + g)).cwiseAbs().maxCoeff(), 1e-14);
+  std::vector<int> support;
+  for (int i = 0; i < n; ++i)
+    if (!H.row(i).isZero() || g[i] != 0.0) support.push_back(i);
+  EXPECT_EQ(form.supportCoordinates(), support);
+  ASSERT_LT(support.size(), static_cast<std::size_t>(n));
+  SupportValues onSupport;
+  EXPECT_NEAR(form.valueAndSupportGradient(q, onSupport), 0.5 * q.dot(H * q) + g.dot(q) + c, 1e-14);
+  EXPECT_LT((form.fromSupport(onSupport) - (H * q + g)).cwiseAbs().maxCoeff(), 1e-14);
+  const ConstraintVector v = randomIsh(VectorXd::Ones(n), 31);
+  EXPECT_NEAR(form.dotOnSupport(onSupport, v), (H * q + g).dot(v), 1e-13);
+  VectorXd scattered = VectorXd::Zero(n);
+  form.addOnSupport(2.0, onSupport, scattered);
+  EXPECT_LT((scattered - 2.0 * (H * q + g)).cwiseAbs().maxCoeff(), 1e-14);
   MatrixXd hessian = MatrixXd::Zero(n, n);
   form.addHessian(1.0, hessian);
   EXPECT_EQ(hessian, MatrixXd(H));

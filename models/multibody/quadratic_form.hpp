@@ -30,8 +30,11 @@ class QuadraticForm {
   ConstraintVector hessianTimes(const ConstraintVector& v) const;
   // grad phi(q) = H q + g
   ConstraintVector gradientAt(const ConstraintVector& q) const { return hessianTimes(q) + gradient_; }
-  // phi(q) = q.(grad phi(q) + g)/2 + c
-  double valueAt(const ConstraintVector& q) const { return 0.5 * q.dot(gradientAt(q) + gradient_) + constant_; }
+  // phi(q), through the support as the residuals take it
+  double valueAt(const ConstraintVector& q) const {
+    SupportValues gradient;
+    return valueAndSupportGradient(q, gradient);
+  }
   // phi(q), and grad phi(q) at the support coordinates only: the residual of a constraint works
   // on the few coordinates a form touches instead of all n (up to 24)
   double valueAndSupportGradient(const ConstraintVector& q, SupportValues& gradient) const;
