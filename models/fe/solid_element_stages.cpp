@@ -56,19 +56,27 @@ struct PointPath {
   double norm = 0.0;
 };
 
-// (basis: the node positions at the start and at each stage; xRate: their tau-rates at each stage)
-PointPath pointPath(const CellPositions (&basis)[kStages + 1], const CellPositions (&xRate)[kStages],
-                    const CellPositions& xEnd, const ShapeGradients& G, const CollocationRule& rule) {
+// (start: the node positions at the step's start; change[j]: their change to stage j). The
+// stage polynomial is linear in the stage values, so are F, its tau-rates and its end value:
+// they come from each stage's change of F, and a rate carries the round-off of the changes.
+PointPath pointPath(const CellPositions& start, const CellPositions (&change)[kStages], const ShapeGradients& G,
+                    const CollocationRule& rule) {
   PointPath path;
+  const Mat3 F0 = start * G;
+  Mat3 dF[kStages];
+  path.FEnd = F0;
   for (int j = 0; j < rule.stages; ++j) {
-    path.F[j] = basis[j + 1] * G;
-    path.rate[j] = xRate[j] * G;
+    dF[j] = change[j] * G;
+    path.FEnd += rule.end[j + 1] * dF[j];
+  }
+  for (int j = 0; j < rule.stages; ++j) {
+    path.F[j] = F0 + dF[j];
+    path.rate[j].setZero();
+    for (int k = 0; k < rule.stages; ++k) path.rate[j] += rule.rate[j][k + 1] * dF[k];
     path.C[j] = path.F[j].transpose() * path.F[j];
     path.strainRate[j] = strainChange(path.F[j], path.rate[j]);
     path.norm += rule.weight[j] * contract(path.strainRate[j], path.strainRate[j]);
   }
-  const Mat3 F0 = basis[0] * G;
-  path.FEnd = xEnd * G;
   path.C0 = F0.transpose() * F0;
   path.CEnd = path.FEnd.transpose() * path.FEnd;
   return path;
@@ -331,14 +339,10 @@ void SolidElement::addStages(const StageArgs& args, int firstStage, int count, L
   auto reject = [&] {
     for (int k = 0; k < count; ++k) rejectInadmissible(out[k]);
   };
-  // node positions at the basis points of the stage polynomial (the start, then each stage)
-  CellPositions basis[kStages + 1], xRate[kStages];
-  basis[0] = positions(args.zOld);
-  for (int j = 0; j < s; ++j) {
-    basis[j + 1] = positions(args.stageState[j]);
-    xRate[j] = args.dt * positions(args.stageRate[j]);
-  }
-  const CellPositions xEnd = positions(args.zEnd);
+  // node positions at the step's start and their change to each stage
+  const CellPositions start = positions(args.zOld);
+  CellPositions change[kStages];
+  for (int j = 0; j < s; ++j) change[j] = positions(args.stageState[j]) - start;
   // a thermal cell's nodes at each stage: T_a,l, the capacity's energy rate, their derivatives
   NodalThermalVariable::Stage node[kStages][kMaxCellNodes];
   if (spec_.thermal)
@@ -354,7 +358,7 @@ void SolidElement::addStages(const StageArgs& args, int firstStage, int count, L
     }
   for (int q = 0; q < static_cast<int>(spec_.points.size()); ++q) {
     // the point's path through all stages, and its energies' stage gradients, serve every stage
-    const PointPath path = pointPath(basis, xRate, xEnd, spec_.points[q].gradients, rule);
+    const PointPath path = pointPath(start, change, spec_.points[q].gradients, rule);
     if (!(path.FEnd.determinant() > 0.0)) return reject();
     for (int k = 0; k < count; ++k)
       if (!(path.F[firstStage + k].determinant() > 0.0)) return reject();
