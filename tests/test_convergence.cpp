@@ -1,10 +1,12 @@
 // Observed order of convergence: the log-log slope of the error at a fixed time against a
 // fine reference of the same integrator is 2 (+- 0.1) for EEM with either thermal variable,
-// the implicit midpoint rule and the trapezoidal rule.
+// the implicit midpoint rule and the trapezoidal rule; fixed steps end on a load's kinks, so
+// that eem4 keeps its order 4 across them.
 #include "support.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace mpx::test {
@@ -54,6 +56,44 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"thermo_visco_elastic.xml", Scheme::Midpoint, ThermalVariable::Temperature, "midpoint"},
                       Case{"thermo_visco_elastic.xml", Scheme::Trapezoidal, ThermalVariable::Temperature,
                            "trapezoidal"}));
+
+// A mass on a spring pushed by a hat load whose kinks (0.3725, 0.745) fall inside a step at
+// every size tried. A step's polynomial cannot follow a kink: an eem4 step across one errs by
+// O(dt^2), as much as a second-order scheme. The fixed steps end on both kinks as well as on
+// every multiple of dt, and eem4 keeps order 4 against IDA at rtol 1e-11.
+TEST(FixedStepsAcrossKinks, EndOnTheKinksAndKeepOrderFour) {
+  constexpr double kKinkEndTime = 1.5;
+  SceneSpec spec;
+  spec.settings.dt = 0.01;
+  spec.settings.tEnd = kKinkEndTime;
+  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
+  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
+  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
+  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0.5, 0)}, {"profile", "hat"}, {"period", 0.745}});
+  const CompiledScene scene = compileScene(spec);
+  ASSERT_EQ(scene.model->loadBreakpoints(), (std::vector<double>{0.3725, 0.745}));
+  const History ida = runIda(*scene.model, 1e-11, kKinkEndTime, false, kKinkEndTime);
+  ASSERT_FALSE(ida.summary.failed) << ida.summary.failure;
+  const Eigen::Index compared = scene.model->layout().offset(Block::Multiplier);
+  std::vector<double> dts(std::begin(kSteps), std::end(kSteps)), errors;
+  std::printf("eem4 across kinks: errors");
+  for (double dt : dts) {
+    const History h = run(*scene.model, Scheme::Eem4, dt, kKinkEndTime);
+    ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+    // one step more per kink; every other step ends on a multiple of dt, or on t_end
+    const std::size_t nominal = static_cast<std::size_t>(std::ceil(kKinkEndTime / dt - 1e-9));
+    EXPECT_EQ(h.time.size() - 1, nominal + 2) << "dt " << dt;
+    for (double kink : {0.3725, 0.745})
+      EXPECT_NE(std::find(h.time.begin(), h.time.end(), kink), h.time.end()) << "no step ends at " << kink;
+    for (double t : h.time)
+      if (t != 0.3725 && t != 0.745 && t != kKinkEndTime) EXPECT_NEAR(t / dt, std::round(t / dt), 1e-9) << "dt " << dt;
+    errors.push_back((h.states.back() - ida.states.back()).head(compared).lpNorm<Eigen::Infinity>());
+    std::printf(" %.3e", errors.back());
+  }
+  const double order = logLogSlope(dts, errors);
+  std::printf(", observed order %.3f\n", order);
+  EXPECT_NEAR(order, 4.0, 0.2);
+}
 
 }  // namespace
 }  // namespace mpx::test

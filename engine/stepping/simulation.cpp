@@ -175,11 +175,20 @@ void ComponentFlows::accept(int k) {
   for (std::size_t c = 0; c < crossed_.size(); ++c) crossed_[c] += slots_[k][c];
 }
 
+namespace {
+// A load breakpoint closer than this fraction of dt to a step's end is taken to be there.
+constexpr double kKinkSlack = 1e-6;
+
+// The first load breakpoint inside (t, end) and clear of both ends, or NaN.
+double kinkWithin(const std::vector<double>& breakpoints, double t, double end, double slack) {
+  const auto kink = std::upper_bound(breakpoints.begin(), breakpoints.end(), t + slack);
+  return kink != breakpoints.end() && *kink < end - slack ? *kink : NAN;
+}
+}  // namespace
+
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink, const ProgressSink& progress) {
   RunSummary summary;
   Integrator integrator(model, options.scheme, options.newton);
-  // the last step is shortened to land on tEnd; a remainder below 1e-9 dt is dropped
-  const auto steps = static_cast<int>(std::ceil(options.tEnd / options.dt - 1e-9));
   const Checkpointing& checkpoints = options.checkpoints;
   RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
   if (checkpoints.resume) integrator.resume(*checkpoints.resume);
@@ -187,25 +196,40 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
   Flows crossed = reporter.last().crossed;
   ComponentFlows byComponent(model, options.componentFlows, 1);
   CheckpointSchedule schedule(checkpoints, reporter.last().step);
-  for (int n = reporter.last().step + 1; n <= steps; ++n) {
+  const double slack = kKinkSlack * options.dt;
+  // One step from the last record's time to `end` over dt; false once the run stops there.
+  int n = reporter.last().step;
+  auto stepTo = [&](double end, double dt) {
     const double t = reporter.last().time;
-    const double dt = std::min(options.dt, options.tEnd - t);
     const StepOutcome outcome = integrator.advance(reporter.state(), t, dt, next, byComponent.slot(0));
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
     summary.factorizations += outcome.factorizations;
     if (!outcome.converged) {
       summary.failed = true;
-      summary.failedStep = n;
+      summary.failedStep = n + 1;
       summary.failedTime = t;
       summary.failure = outcome.failure;
-      break;
+      return false;
     }
     reporter.state().swap(next);
     crossed += outcome.energy;
     byComponent.accept(0);
-    const bool goOn = reporter.report(n, n == steps ? options.tEnd : t + dt, dt, crossed, outcome.iterations,
-                                      outcome.cutbacks, byComponent.crossed());
+    return reporter.report(++n, end, dt, crossed, outcome.iterations, outcome.cutbacks, byComponent.crossed());
+  };
+  // Steps of dt, the last one shortened to land on tEnd (a remainder below 1e-9 dt is dropped).
+  // A step with a load breakpoint inside ends there and the next one goes on to the step's end:
+  // a step's polynomial cannot follow a kink (eem4 across one is second order), and the steps
+  // still end on the multiples of dt.
+  while (reporter.last().time < options.tEnd - 1e-9 * options.dt) {
+    const double t = reporter.last().time;
+    const bool last = t + options.dt >= options.tEnd - 1e-9 * options.dt;
+    const double end = last ? options.tEnd : t + options.dt;
+    const double kink = kinkWithin(model.loadBreakpoints(), t, end, slack);
+    // a stop request waits for the step's end, where a checkpoint can take the run up again
+    if (!std::isnan(kink) && !stepTo(kink, kink - t) && summary.failed) break;
+    const double dt = std::isnan(kink) ? std::min(options.dt, options.tEnd - t) : end - kink;
+    const bool goOn = stepTo(end, dt);
     if (summary.failed) break;
     if (schedule.due(n, summary.interrupted)) {
       LoopState saved;
