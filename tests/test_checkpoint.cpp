@@ -25,12 +25,14 @@ std::vector<std::string> rowsFrom(const std::vector<std::string>& lines, const s
   return {};
 }
 
-// A scene, an integrator, the end time of the whole run and the checkpoint interval.
+// A scene, an integrator, the end time of the whole run, the checkpoint interval and further
+// options.
 struct Restart {
   const char* scene;
   const char* integrator;
   double tEnd;
   int every;
+  const char* options = "";
 };
 
 std::ostream& operator<<(std::ostream& os, const Restart& r) { return os << r.scene << " " << r.integrator; }
@@ -43,8 +45,8 @@ class CheckpointTest : public CliTest, public ::testing::WithParamInterface<Rest
 TEST_P(CheckpointTest, ARestartContinuesTheRunBitForBit) {
   const Restart& c = GetParam();
   const std::string scene = quoted(fs::path(mpx::test::scenePath(c.scene)));
-  const std::string options =
-      " --integrator " + std::string(c.integrator) + " --checkpoint-every " + std::to_string(c.every) + " --t-end ";
+  const std::string options = " --integrator " + std::string(c.integrator) + " " + c.options + " --checkpoint-every " +
+                              std::to_string(c.every) + " --t-end ";
   const std::string wholeEnd = std::to_string(c.tEnd), halfEnd = std::to_string(c.tEnd / 2);
   const fs::path whole = dir_ / "whole", half = dir_ / "half", restarted = dir_ / "restarted";
   const Invocation wholeRun = metriplex("run " + scene + options + wholeEnd + " --out " + quoted(whole));
@@ -73,7 +75,8 @@ TEST_P(CheckpointTest, ARestartContinuesTheRunBitForBit) {
 }
 
 // the thermo-springs (a thermal network), a closed loop under the augmented Lagrangian (KLU,
-// whose pivots a checkpoint renews) and a thermo-viscoelastic solid (internal variables)
+// whose pivots a checkpoint renews), a thermo-viscoelastic solid (internal variables), and a
+// ramp load whose end (t = 2) splits a fixed step after the last checkpoint of the half run (t = 1.8)
 INSTANTIATE_TEST_SUITE_P(Cli, CheckpointTest,
                          ::testing::Values(Restart{"two_thermo_springs.xml", "eem", 200, 37},
                                            Restart{"two_thermo_springs.xml", "eem-adaptive", 200, 37},
@@ -82,7 +85,8 @@ INSTANTIATE_TEST_SUITE_P(Cli, CheckpointTest,
                                            Restart{"two_thermo_springs.xml", "eem4-adaptive", 200, 37},
                                            Restart{"four_bar_revolute.xml", "eem", 0.5, 7},
                                            Restart{"four_bar_revolute.xml", "eem-adaptive", 0.5, 7},
-                                           Restart{"lblock_thermoviscoelastic.xml", "eem", 0.5, 7}),
+                                           Restart{"lblock_thermoviscoelastic.xml", "eem", 0.5, 7},
+                                           Restart{"damped_pendulum_spring.xml", "eem4", 4.2, 20, "--dt 0.03"}),
                          [](const auto& info) {
                            std::string name = std::string(info.param.scene) + "_" + info.param.integrator;
                            for (char& ch : name)
