@@ -9,6 +9,9 @@
 namespace mpx {
 
 namespace {
+// eem4's stage miss scales to a step at most this much longer than the step it was seen on.
+constexpr double kLargestMissScaling = 8.0;
+
 // The components' local form each scheme evaluates.
 Component::LocalForm localForm(Scheme scheme) {
   if (scheme == Scheme::Eem) return Component::LocalForm::Step;
@@ -199,10 +202,12 @@ bool Integrator::advanceLevel(const Eigen::VectorXd& z, double t, double dt, int
       for (int l = 0; l < rule_.stages; ++l) extrapolate(t + rule_.node[l] * dt, stages_.segment(l * n, n));
       // the polynomial runs through step ends, accurate to dt^4, but Newton's target is the Gauss
       // stages, which miss the trajectory by dt^3: where the steps resolve the motion, the last
-      // step's miss, scaled to this step, is added
+      // step's miss, scaled to this step, is added (not after a much shorter step, a sliver before
+      // a load breakpoint, whose miss is round-off that the scaling would blow up)
       stagePrediction_ = stages_;
       stagesPredicted_ = true;
-      if (stageMissKept_ && motionResolved_) stages_ += std::pow(dt / stageMissDt_, 3) * stageMiss_;
+      if (stageMissKept_ && motionResolved_ && dt <= kLargestMissScaling * stageMissDt_)
+        stages_ += std::pow(dt / stageMissDt_, 3) * stageMiss_;
     } else {
       extrapolate(t + dt, zNew);
     }

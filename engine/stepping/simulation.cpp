@@ -217,18 +217,25 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     byComponent.accept(0);
     return reporter.report(++n, end, dt, crossed, outcome.iterations, outcome.cutbacks, byComponent.crossed());
   };
-  // Steps of dt, the last one shortened to land on tEnd (a remainder below 1e-9 dt is dropped).
-  // A step with a load breakpoint inside ends there and the next one goes on to the step's end:
-  // a step's polynomial cannot follow a kink (eem4 across one is second order), and the steps
+  // Steps of dt, the last one shortened to land on tEnd (a remainder below 1e-9 dt is dropped);
+  // the step count, not the time summed step by step, says which step is the last.
+  const auto steps = static_cast<long long>(std::ceil(options.tEnd / options.dt - 1e-9));
+  // A step with load breakpoints inside ends on each of them before it goes on to its end: a
+  // step's polynomial cannot follow a kink (eem4 across one is second order), and the steps
   // still end on the multiples of dt.
-  while (reporter.last().time < options.tEnd - 1e-9 * options.dt) {
+  while (reporter.last().time < options.tEnd) {
     const double t = reporter.last().time;
-    const bool last = t + options.dt >= options.tEnd - 1e-9 * options.dt;
+    const bool last = std::llround(t / options.dt) + 1 >= steps;
     const double end = last ? options.tEnd : t + options.dt;
-    const double kink = kinkWithin(model.loadBreakpoints(), t, end, slack);
     // a stop request waits for the step's end, where a checkpoint can take the run up again
-    if (!std::isnan(kink) && !stepTo(kink, kink - t) && summary.failed) break;
-    const double dt = std::isnan(kink) ? std::min(options.dt, options.tEnd - t) : end - kink;
+    bool split = false;
+    for (double kink; !summary.failed &&
+                      !std::isnan(kink = kinkWithin(model.loadBreakpoints(), reporter.last().time, end, slack));) {
+      stepTo(kink, kink - reporter.last().time);
+      split = true;
+    }
+    if (summary.failed) break;
+    const double dt = split ? end - reporter.last().time : std::min(options.dt, options.tEnd - t);
     const bool goOn = stepTo(end, dt);
     if (summary.failed) break;
     if (schedule.due(n, summary.interrupted)) {
