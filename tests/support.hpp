@@ -40,6 +40,20 @@ inline std::string schemeName(Scheme scheme) {
   return "unknown";
 }
 
+// The smallest scene with load breakpoints: a mass on a spring (k = 40, rest length 1) from a
+// wall, pushed by `force` along a load profile, e.g. {{"profile", "hat"}, {"period", 0.7}}.
+inline CompiledScene pushedSpring(double dt, double tEnd, const Vec3& force, std::initializer_list<Attribute> profile) {
+  SceneSpec spec;
+  spec.settings.dt = dt;
+  spec.settings.tEnd = tEnd;
+  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
+  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
+  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
+  ElementSpec& push = spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", force}});
+  for (const Attribute& attribute : profile) push.set(attribute.name, attribute.value);
+  return compileScene(spec);
+}
+
 // Everything a run reports, step by step.
 struct History {
   std::vector<double> time, dt, energy, entropy, dissipated, externalWork, boundaryHeat, boundaryEntropy;

@@ -99,14 +99,7 @@ INSTANTIATE_TEST_SUITE_P(Schemes, AdaptiveSteps,
 // every breakpoint and output time is a step end, bit for bit, and the work the load did
 // balances the energy at every step
 TEST(AdaptiveLandings, StepsLandOnBreakpointsAndOutputTimes) {
-  SceneSpec spec;
-  spec.settings.dt = 0.05;
-  spec.settings.tEnd = 1.6;
-  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
-  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
-  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
-  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0.5, 0)}, {"profile", "hat"}, {"period", 0.7}});
-  const CompiledScene scene = compileScene(spec);
+  const CompiledScene scene = pushedSpring(0.05, 1.6, Vec3(1, 0.5, 0), {{"profile", "hat"}, {"period", 0.7}});
   EXPECT_EQ(scene.model->loadBreakpoints(), (std::vector<double>{0.35, 0.7}));
   const History h = runAdaptive(*scene.model, Scheme::Eem, 1e-6, 1.6, 0.05, 0.25);
   for (double landing : {0.25, 0.35, 0.5, 0.7, 0.75, 1.0, 1.25, 1.5, 1.6})
@@ -126,13 +119,7 @@ TEST(AdaptiveLandings, StepsLandOnBreakpointsAndOutputTimes) {
 // is the same landing, so the step lands on the breakpoint itself, with no sliver of a step
 // after it
 TEST(AdaptiveLandings, OutputTimesUlpsFromABreakpointAreOneLanding) {
-  SceneSpec spec;
-  spec.settings.dt = spec.settings.tEnd = 0.9;
-  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
-  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
-  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
-  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0, 0)}, {"profile", "ramp"}, {"end", 0.9}});
-  const CompiledScene scene = compileScene(spec);
+  const CompiledScene scene = pushedSpring(0.9, 0.9, Vec3(1, 0, 0), {{"profile", "ramp"}, {"end", 0.9}});
   ASSERT_LT(3 * 0.3, 0.9);
   const History h = runAdaptive(*scene.model, Scheme::Eem, 1e-6, 0.9, 0.05, 0.3);
   EXPECT_EQ(h.time.back(), 0.9);

@@ -63,14 +63,8 @@ INSTANTIATE_TEST_SUITE_P(
 // every multiple of dt, and eem4 keeps order 4 against IDA at rtol 1e-11.
 TEST(FixedStepsAcrossKinks, EndOnTheKinksAndKeepOrderFour) {
   constexpr double kKinkEndTime = 1.5;
-  SceneSpec spec;
-  spec.settings.dt = 0.01;
-  spec.settings.tEnd = kKinkEndTime;
-  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
-  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
-  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
-  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0.5, 0)}, {"profile", "hat"}, {"period", 0.745}});
-  const CompiledScene scene = compileScene(spec);
+  const CompiledScene scene =
+      pushedSpring(0.01, kKinkEndTime, Vec3(1, 0.5, 0), {{"profile", "hat"}, {"period", 0.745}});
   ASSERT_EQ(scene.model->loadBreakpoints(), (std::vector<double>{0.3725, 0.745}));
   const History ida = runIda(*scene.model, 1e-11, kKinkEndTime, false, kKinkEndTime);
   ASSERT_FALSE(ida.summary.failed) << ida.summary.failure;
@@ -101,14 +95,7 @@ TEST(FixedStepsAcrossKinks, EndOnTheKinksAndKeepOrderFour) {
 // step still ends on its multiple of dt; a run of 20000 steps takes 20000, although the time
 // summed step by step falls short of t_end by more than the 1e-9 dt a remainder may have.
 TEST(FixedStepsAcrossKinks, EndOnEveryBreakpointAndCountTheirSteps) {
-  SceneSpec spec;
-  spec.settings.dt = 0.13;
-  spec.settings.tEnd = 0.39;
-  spec.add("anchor", {{"name", "wall"}, {"position", Vec3(0, 0, 0)}});
-  spec.add("mass", {{"name", "m"}, {"mass", 1.0}, {"position", Vec3(1, 0, 0)}});
-  spec.add("spring", {{"name", "s"}, {"a", "wall"}, {"b", "m"}, {"stiffness", 40.0}, {"rest_length", 1.0}});
-  spec.add("force", {{"name", "push"}, {"on", "m"}, {"force", Vec3(1, 0.5, 0)}, {"profile", "hat"}, {"period", 0.1}});
-  const CompiledScene scene = compileScene(spec);
+  const CompiledScene scene = pushedSpring(0.13, 0.39, Vec3(1, 0.5, 0), {{"profile", "hat"}, {"period", 0.1}});
   const History h = run(*scene.model, Scheme::Eem4, 0.13, 0.39);
   ASSERT_FALSE(h.summary.failed) << h.summary.failure;
   ASSERT_EQ(h.time.size(), 6u);
