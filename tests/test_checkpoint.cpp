@@ -160,6 +160,31 @@ TEST_F(CliTest, ARestartKeepsTheFrameTimesOfTheWholeRun) {
   EXPECT_EQ(expected.size(), 3u) << "t = 0.3, 0.4, 0.5";
 }
 
+// A run that ended between two multiples of dt (t = 1.05, dt 0.1), restarted to t = 2: every
+// row's dt is the time since the row before, so the last step spans what remains to t_end
+// (before, it took dt and was reported at t_end)
+TEST_F(CliTest, ARestartFromBetweenStepsEndsOnTheEndTime) {
+  const std::string options = " --dt 0.1 --checkpoint-every 1 --t-end ";
+  const fs::path first = dir_ / "first", restarted = dir_ / "restarted";
+  ASSERT_EQ(metriplex("run " + kScene + options + "1.05 --out " + quoted(first)).exitCode, kExitSuccess);
+  ASSERT_EQ(metriplex("run " + kScene + options + "2 --restart " + quoted(first / "checkpoint.txt") + " --out " +
+                      quoted(restarted))
+                .exitCode,
+            kExitSuccess);
+  const std::vector<std::string> rows = splitLines(readFile(restarted / "history.csv"));
+  std::vector<double> time, dt;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i].empty() || rows[i][0] == '#') continue;
+    const std::vector<std::string> fields = splitFields(rows[i]);
+    time.push_back(std::stod(fields[0]));
+    dt.push_back(std::stod(fields[1]));
+  }
+  ASSERT_GE(time.size(), 3u);
+  EXPECT_EQ(time.front(), 1.05);
+  EXPECT_EQ(time.back(), 2.0);
+  for (std::size_t k = 1; k < time.size(); ++k) EXPECT_NEAR(dt[k], time[k] - time[k - 1], 1e-12) << "row " << k;
+}
+
 TEST_F(CliTest, IdaRefusesCheckpoints) {
   for (const std::string option : {"--checkpoint-every 10", "--restart nothing.txt"}) {
     const Invocation r = metriplex("run " + kScene + " --integrator ida " + option + " --out " + quoted(outDir()));

@@ -217,7 +217,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     byComponent.accept(0);
     return reporter.report(++n, end, dt, crossed, outcome.iterations, outcome.cutbacks, byComponent.crossed());
   };
-  // Steps of dt, the last one shortened to land on tEnd (a remainder below 1e-9 dt is dropped);
+  // Steps of dt, the last one over what remains to tEnd (a remainder below 1e-9 dt is dropped);
   // the step count, not the time summed step by step, says which step is the last.
   const auto steps = static_cast<long long>(std::ceil(options.tEnd / options.dt - 1e-9));
   // A step with load breakpoints inside ends on each of them before it goes on to its end: a
@@ -235,7 +235,7 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
       split = true;
     }
     if (summary.failed) break;
-    const double dt = split ? end - reporter.last().time : std::min(options.dt, options.tEnd - t);
+    const double dt = split || last ? end - reporter.last().time : options.dt;
     const bool goOn = stepTo(end, dt);
     if (summary.failed) break;
     if (schedule.due(n, summary.interrupted)) {
