@@ -227,10 +227,12 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     const double t = reporter.last().time;
     const bool last = std::llround(t / options.dt) + 1 >= steps;
     const double end = last ? options.tEnd : t + options.dt;
-    // a stop request waits for the step's end, where a checkpoint can take the run up again
+    // first to each load breakpoint inside the step; a stop request waits for the step's end,
+    // where a checkpoint can take the run up again
     bool split = false;
-    for (double kink; !summary.failed &&
-                      !std::isnan(kink = kinkWithin(model.loadBreakpoints(), reporter.last().time, end, slack));) {
+    while (!summary.failed) {
+      const double kink = kinkWithin(model.loadBreakpoints(), reporter.last().time, end, slack);
+      if (std::isnan(kink)) break;
       stepTo(kink, kink - reporter.last().time);
       split = true;
     }
