@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <utility>
 #include <vector>
@@ -84,6 +85,7 @@ class UrdfFile {
     const tinyxml2::XMLElement& robot = parseStrictXml(document, text_, path_, TextContent::Allowed);
     for (const tinyxml2::XMLElement* e = robot.FirstChildElement(); e; e = e->NextSiblingElement())
       if (const char* name = e->Attribute("name")) lines_.emplace(key(e->Name(), name), e->GetLineNum());
+    checkNoPercent(robot);
     checkJointTree(robot);
   }
 
@@ -105,6 +107,23 @@ class UrdfFile {
 
  private:
   static std::string key(const std::string& kind, const std::string& name) { return kind + " " + name; }
+
+  // urdfdom writes some of its messages with the value it rejects as the printf format, so a
+  // '%' there would be read as a directive and read memory that is not there (the fuzzer found
+  // a mass of "...%77777777s..."): no attribute value or text may hold one.
+  void checkNoPercent(const tinyxml2::XMLElement& element) const {
+    for (const tinyxml2::XMLAttribute* a = element.FirstAttribute(); a; a = a->Next())
+      if (std::strchr(a->Value(), '%'))
+        throw InputError(path_, a->GetLineNum(),
+                         "<" + std::string(element.Name()) + ">: attribute '" + a->Name() +
+                             "' holds a '%', which urdfdom's messages would read as a printf directive");
+    if (const char* text = element.GetText(); text && std::strchr(text, '%'))
+      throw InputError(path_, element.GetLineNum(),
+                       "<" + std::string(element.Name()) +
+                           ">: its text holds a '%', which urdfdom's messages would read as a printf directive");
+    for (const tinyxml2::XMLElement* child = element.FirstChildElement(); child; child = child->NextSiblingElement())
+      checkNoPercent(*child);
+  }
 
   // The joints must form a tree before urdfdom sees them: it links parents and children by
   // shared_ptr, and links on a cycle would own each other and never be freed (the fuzzer found
