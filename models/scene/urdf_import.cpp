@@ -110,7 +110,8 @@ class UrdfFile {
 
   // urdfdom writes some of its messages with the value it rejects as the printf format, so a
   // '%' there would be read as a directive and read memory that is not there (the fuzzer found
-  // a mass of "...%77777777s..."): no attribute value or text may hold one.
+  // a mass of "...%77777777s..."): no attribute value or text may hold one. (The recursion is
+  // as deep as the file's nesting, which tinyxml2 limits to TINYXML2_MAX_ELEMENT_DEPTH = 100.)
   void checkNoPercent(const tinyxml2::XMLElement& element) const {
     for (const tinyxml2::XMLAttribute* a = element.FirstAttribute(); a; a = a->Next())
       if (std::strchr(a->Value(), '%'))
