@@ -59,6 +59,7 @@ struct History {
   std::vector<double> time, dt, energy, entropy, dissipated, externalWork, boundaryHeat, boundaryEntropy;
   std::vector<Vec3> momentum, angularMomentum;
   std::vector<Eigen::VectorXd> states;
+  std::vector<int> newtonIterations;  // of each step
   RunSummary summary;
 };
 
@@ -78,6 +79,7 @@ History collect(Runner runWith) {
     h.momentum.push_back(r.measures->momentum);
     h.angularMomentum.push_back(r.measures->angularMomentum);
     h.states.push_back(*r.state);
+    h.newtonIterations.push_back(r.newtonIterations);
   });
   return h;
 }

@@ -115,5 +115,22 @@ TEST(FixedStepsAcrossKinks, EndOnEveryBreakpointAndCountTheirSteps) {
   EXPECT_EQ(longRun.dt.back(), 200.0 - longRun.time[longRun.time.size() - 2]);
 }
 
+// A breakpoint 1e-6 of a step past a multiple of dt (a hat's end at 0.6000001, dt 0.1) leaves a
+// sliver of a step before it. eem4's predictor adds the last step's stage miss scaled to the new
+// step; from the sliver that scaling (1e18) would turn a round-off miss into a wrong start, and
+// the step after it took more Newton iterations than any other. It takes no more than the steps
+// before the breakpoint.
+TEST(FixedStepsAcrossKinks, ASliverLeavesTheNextPredictionAlone) {
+  const CompiledScene scene = pushedSpring(0.1, 1.0, Vec3(1, 0.5, 0), {{"profile", "hat"}, {"period", 0.6000001}});
+  const History h = run(*scene.model, Scheme::Eem4, 0.1, 1.0);
+  ASSERT_FALSE(h.summary.failed) << h.summary.failure;
+  const auto sliver = std::find(h.time.begin(), h.time.end(), 0.6000001);
+  ASSERT_NE(sliver, h.time.end());
+  const std::size_t k = static_cast<std::size_t>(sliver - h.time.begin());
+  ASSERT_LT(h.dt[k], 1e-6);
+  const int elsewhere = *std::max_element(h.newtonIterations.begin() + 1, h.newtonIterations.begin() + k - 1);
+  EXPECT_LE(h.newtonIterations[k + 1], elsewhere) << "the step after the sliver";
+}
+
 }  // namespace
 }  // namespace mpx::test

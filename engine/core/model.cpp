@@ -1,6 +1,7 @@
 #include "engine/core/model.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace mpx {
 
@@ -21,6 +22,11 @@ Model::Model(Layout layout, ThermalVariable thermalVariable, std::vector<std::un
   std::stable_partition(components_.begin(), components_.end(),
                         [](const std::unique_ptr<Component>& c) { return !c->isCoupling(); });
   for (std::size_t i = 0; i < components_.size(); ++i) components_[i]->modelIndex_ = static_cast<int>(i);
+}
+
+double Model::nextLoadBreakpoint(double t) const {
+  const auto next = std::upper_bound(loadBreakpoints_.begin(), loadBreakpoints_.end(), t);
+  return next == loadBreakpoints_.end() ? INFINITY : *next;
 }
 
 void Model::measure(const Eigen::VectorXd& z, Measures& out) const {

@@ -49,6 +49,8 @@ class Model {
   const std::vector<PrescribedMotion>& prescribedMotions() const { return prescribedMotions_; }
   // Times where a load or prescribed motion has a kink, increasing and distinct.
   const std::vector<double>& loadBreakpoints() const { return loadBreakpoints_; }
+  // The first load breakpoint after t, or infinity: where the time loops land their steps.
+  double nextLoadBreakpoint(double t) const;
 
   // Energy, entropy, momenta and node temperatures of state z; `out` is reused (no allocation
   // once sized).

@@ -137,8 +137,8 @@ class LocalError {
 // Where steps must land: load breakpoints, multiples of the output interval, t_end.
 class Landings {
  public:
-  Landings(const std::vector<double>& breakpoints, double outputInterval, double tEnd)
-      : breakpoints_(breakpoints), interval_(outputInterval), tEnd_(tEnd) {}
+  Landings(const Model& model, double outputInterval, double tEnd)
+      : model_(model), interval_(outputInterval), tEnd_(tEnd) {}
 
   // The first landing time after t, and whether the loads have a kink there.
   std::pair<double, bool> after(double t) const {
@@ -148,13 +148,13 @@ class Landings {
     double next = tEnd_;
     if (interval_ > 0.0) next = std::min(next, (std::floor((t + slack) / interval_) + 1.0) * interval_);
     if (next > tEnd_ - slack) next = tEnd_;
-    const auto kink = std::upper_bound(breakpoints_.begin(), breakpoints_.end(), t + slack);
-    if (kink != breakpoints_.end() && *kink <= next + slack) return {*kink, true};
+    const double kink = model_.nextLoadBreakpoint(t + slack);
+    if (kink <= next + slack) return {kink, true};
     return {next, false};
   }
 
  private:
-  const std::vector<double>& breakpoints_;
+  const Model& model_;
   double interval_, tEnd_;
 };
 
@@ -171,7 +171,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   const Checkpointing& checkpoints = options.checkpoints;
   RunReporter reporter(model, summary, sink, progress, options.tEnd, checkpoints.resume);
   LocalError localError(model, control, schemeOrder(options.scheme));
-  const Landings landings(model.loadBreakpoints(), control.outputInterval, options.tEnd);
+  const Landings landings(model, control.outputInterval, options.tEnd);
   const int n = model.layout().total();
   Eigen::VectorXd next(n), half(n), fullStep(n);
   Flows crossed = reporter.last().crossed;

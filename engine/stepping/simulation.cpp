@@ -178,12 +178,6 @@ void ComponentFlows::accept(int k) {
 namespace {
 // A load breakpoint closer than this fraction of dt to a step's end is taken to be there.
 constexpr double kKinkSlack = 1e-6;
-
-// The first load breakpoint inside (t, end) and clear of both ends, or NaN.
-double kinkWithin(const std::vector<double>& breakpoints, double t, double end, double slack) {
-  const auto kink = std::upper_bound(breakpoints.begin(), breakpoints.end(), t + slack);
-  return kink != breakpoints.end() && *kink < end - slack ? *kink : NAN;
-}
 }  // namespace
 
 RunSummary simulate(const Model& model, const RunOptions& options, const StepSink& sink, const ProgressSink& progress) {
@@ -231,8 +225,8 @@ RunSummary simulate(const Model& model, const RunOptions& options, const StepSin
     // where a checkpoint can take the run up again
     bool split = false;
     while (!summary.failed) {
-      const double kink = kinkWithin(model.loadBreakpoints(), reporter.last().time, end, slack);
-      if (std::isnan(kink)) break;
+      const double kink = model.nextLoadBreakpoint(reporter.last().time + slack);
+      if (!(kink < end - slack)) break;
       stepTo(kink, kink - reporter.last().time);
       split = true;
     }

@@ -73,7 +73,7 @@ bool QuadraticConstraint::couples(int row, int column, LocalForm form) const {
 }
 
 double QuadraticConstraint::multiplier(const double* z, std::size_t k) const {
-  return augmented() && !implied_[k] ? z[spec_.firstMultiplierDof + k] : 0.0;
+  return lambdaUnknown(k) ? z[spec_.firstMultiplierDof + k] : 0.0;
 }
 
 void QuadraticConstraint::spatialVectors(std::vector<SpatialVector>& out) const {
@@ -242,7 +242,7 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
   const int column = args.column, n = positionCount_;
   const QuadraticForm& form = spec_.forms[k];
   StageProjection out;
-  out.lambdaUnknown = augmented() && !implied_[k];
+  out.lambdaUnknown = lambdaUnknown(k);
   double lambda[CollocationRule::kMostStages] = {};
   if (out.lambdaUnknown)
     for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];

@@ -66,6 +66,8 @@ class QuadraticConstraint final : public Component {
   // lambda_k (0 for penalty and for an implied form, whose lambda is held at zero).
   double multiplier(const double* z, std::size_t k) const;
   bool augmented() const { return spec_.enforcement == Enforcement::AugmentedLagrangian; }
+  // Whether lambda_k is an unknown of the step (augmented Lagrangian, and the form not implied).
+  bool lambdaUnknown(std::size_t k) const { return augmented() && !implied_[k]; }
   // The stage form for stages firstStage .. firstStage + count - 1 into out[0 .. count - 1]: the
   // residuals, and with args.tangent (count 1) the derivative w.r.t. stage args.column.
   void addStages(const StageArgs& args, int firstStage, int count, LocalSystem* out) const;
