@@ -2,9 +2,10 @@
 // summed over its element groups gives history.csv's energy, entropy, dissipated energy,
 // external work, boundary heat, boundary entropy and entropy production at every output time,
 // to round-off; each flow sits with the element that caused it; runs IDA cannot split are
-// refused before anything is written.
+// refused before anything is written; the budget plot's labels cannot leave their strings.
 #include "support.hpp"
 
+#include "tools/output/gnuplot.hpp"
 #include "tools/session/run_session.hpp"
 
 #include "engine/core/input_error.hpp"
@@ -144,6 +145,28 @@ TEST(Budget, RefusedWhereFlowsPerElementAreNotKept) {
   request.integrator = "eem";
   request.restart = "checkpoint.txt";
   EXPECT_THROW(prepareRun(request), InputError);
+}
+
+// A label reaches gnuplot as one string whatever it holds: a newline followed by '!' would run a
+// shell command if it ended the string's line; gnuplot prints the label back byte for byte.
+TEST(Budget, PlotLabelsStayStrings) {
+  const fs::path dir = fs::temp_directory_path() / "metriplex-gnuplot-label";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path touched = dir / "touched";
+  const std::string label = "a\n!touch " + touched.string() + "\nb \"q\" 'r' \\z\t";
+  {
+    std::ofstream script(dir / "label.gp");
+    script << "set print " << gnuplotQuoted((dir / "printed.txt").string()) << "\nprint " << gnuplotQuoted(label)
+           << "\n";
+  }
+  runGnuplot(dir / "label.gp", dir / "label.log");
+  EXPECT_FALSE(fs::exists(touched));
+  std::ifstream printed(dir / "printed.txt");
+  std::stringstream text;
+  text << printed.rdbuf();
+  EXPECT_EQ(text.str(), label + "\n");
+  fs::remove_all(dir);
 }
 
 }  // namespace

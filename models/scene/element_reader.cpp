@@ -1,5 +1,8 @@
 #include "models/scene/element_reader.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -8,8 +11,14 @@ namespace mpx {
 
 std::string echoed(const std::string& value) {
   constexpr std::size_t kLongest = 64;
-  if (value.size() <= kLongest) return value;
-  return value.substr(0, kLongest) + "... (" + std::to_string(value.size()) + " characters)";
+  // a control character shows as \xHH, so that a message stays one line of plain text
+  std::string shown;
+  for (std::size_t i = 0; i < std::min(value.size(), kLongest); ++i) {
+    const auto byte = static_cast<unsigned char>(value[i]);
+    shown += byte < 0x20 || byte == 0x7f ? fmt::format("\\x{:02x}", byte) : std::string(1, value[i]);
+  }
+  if (value.size() <= kLongest) return shown;
+  return shown + "... (" + std::to_string(value.size()) + " characters)";
 }
 
 ElementReader::ElementReader(const ElementSpec& element) : element_(element) {}
@@ -80,11 +89,11 @@ double ElementReader::nonNegative(const char* attribute, double fallback) {
   return value;
 }
 
-int ElementReader::count(const char* attribute, int fallback, int largest) {
+int ElementReader::count(const char* attribute, int fallback, int smallest, int largest) {
   const double value = number(attribute, fallback);
-  if (value < 0 || value > largest || value != std::floor(value))
-    fail(std::string("attribute '") + attribute + "' must be an integer from 0 to " + std::to_string(largest) +
-         ", got " + echoed(text(attribute)));
+  if (value < smallest || value > largest || value != std::floor(value))
+    fail(std::string("attribute '") + attribute + "' must be an integer from " + std::to_string(smallest) + " to " +
+         std::to_string(largest) + ", got " + echoed(text(attribute)));
   return static_cast<int>(value);
 }
 

@@ -12,7 +12,8 @@
 
 namespace mpx {
 
-// A value as quoted in a message: whole up to 64 characters, else its start and its length.
+// A value as quoted in a message: whole up to 64 characters, else its start and its length;
+// control characters as \xHH.
 std::string echoed(const std::string& value);
 
 class ElementReader {
@@ -28,8 +29,8 @@ class ElementReader {
   double positive(const char* attribute);
   double positive(const char* attribute, double fallback);
   double nonNegative(const char* attribute, double fallback);
-  // An integer from 0 to `largest`.
-  int count(const char* attribute, int fallback, int largest);
+  // An integer from `smallest` to `largest`.
+  int count(const char* attribute, int fallback, int smallest, int largest);
   Vec3 vector(const char* attribute, const Vec3& fallback);
   // "true" or "false".
   bool flag(const char* attribute, bool fallback);

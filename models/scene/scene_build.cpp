@@ -72,6 +72,11 @@ void SceneBuild::allocate(const Layout& assigned) {
 std::string SceneBuild::declareName(ElementReader& in) {
   const std::string name = in.text("name");
   if (name.empty()) in.fail("name must not be empty");
+  // names head CSV columns and label plots: a comma or quote would shift the columns, a newline the rows
+  const bool plain = std::none_of(name.begin(), name.end(),
+                                  [](unsigned char c) { return c < 0x20 || c == 0x7f || c == ',' || c == '"'; });
+  if (!plain)
+    in.fail("name '" + echoed(name) + "' heads CSV columns, so it must hold no comma, quote or control character");
   const auto [first, inserted] = names_.emplace(name, in.element().where);
   if (!inserted) {
     const SourceLocation& there = first->second;

@@ -1,5 +1,7 @@
 #include "tools/output/gnuplot.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -19,9 +21,19 @@ std::string shellQuoted(const std::string& text) {
 }  // namespace
 
 std::string gnuplotQuoted(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
-  return quoted + "'";
+  // a newline would end the command inside the string and start another (gnuplot runs a line
+  // that starts with '!' in the shell); in double quotes gnuplot reads octal escapes instead
+  std::string quoted = "\"";
+  for (char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\')
+      quoted += std::string("\\") + c;
+    else if (byte < 0x20 || byte == 0x7f)
+      quoted += fmt::format("\\{:03o}", byte);
+    else
+      quoted += c;
+  }
+  return quoted + "\"";
 }
 
 void runGnuplot(const std::filesystem::path& script, const std::filesystem::path& log) {
