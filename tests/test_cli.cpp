@@ -397,14 +397,16 @@ TEST_F(CliTest, UnknownSubcommandAndUnusableOutputDirectoryAreNamed) {
 }
 
 // IDA's rate form cannot impose a displacement step by step: refused before anything is written,
-// naming the scene and the element (run, and bench when ida is all it is asked for).
+// naming the scene, the element and its line (run, and bench when ida is all it is asked for).
 TEST_F(CliTest, IdaRefusesAPrescribedDisplacement) {
-  const fs::path scene = writeScene(readFile(mpx::test::scenePath("stretched_bar.xml")));
+  const std::string xml = readFile(mpx::test::scenePath("stretched_bar.xml"));
+  const fs::path scene = writeScene(xml);
+  const auto line = 1 + std::count(xml.begin(), xml.begin() + xml.find("<prescribed_displacement"), '\n');
+  const std::string where = scene.string() + ":" + std::to_string(line) + ": <prescribed_displacement>";
   for (const std::string command : {"run --integrator ida", "bench --integrators ida"}) {
     const Invocation r = metriplex(command + " " + quoted(scene) + " --out " + quoted(outDir()));
     EXPECT_EQ(r.exitCode, kExitInvalidInput) << command << ": " << r.err;
-    EXPECT_NE(r.err.find(scene.string()), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("<prescribed_displacement>"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(where), std::string::npos) << where << " in " << r.err;
     EXPECT_FALSE(fs::exists(outDir()));
   }
 }

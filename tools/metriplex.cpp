@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
                   "checkpoint's step");
   run->add_flag(
       "--budget", request.budget,
-      "eem, midpoint, trapezoidal: write DIR/budget.csv and budget.png, energy and entropy per scene element");
+      "one-step integrators (not ida): write DIR/budget.csv and budget.png, energy and entropy per scene element");
   run->add_option("--output-interval", request.frameInterval,
                   "interval of bodies.csv, joints.csv and budget.csv rows and of solid frames (.vtu) (default: every "
                   "history row)");

@@ -30,6 +30,8 @@ struct PrescribedMotion {
   double amplitude;
   TimeFunction profile;
   PrescribedKind kind = PrescribedKind::Velocity;
+  // the scene element that prescribes it (e.g. "scene.xml:12: <prescribed_displacement>"), for messages
+  std::string declaredAt;
 };
 
 class Model {

@@ -44,8 +44,8 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
   if (!method.isIda()) return;
   for (const PrescribedMotion& motion : model.prescribedMotions())
     if (motion.kind == PrescribedKind::Displacement)
-      throw InputError(scene +
-                       ": integrator 'ida' cannot impose a <prescribed_displacement>: give the motion as a "
+      throw InputError(motion.declaredAt +
+                       ": integrator 'ida' cannot impose a prescribed displacement: give the motion as a "
                        "<prescribed_velocity>, or use a one-step integrator");
 }
 

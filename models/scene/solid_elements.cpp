@@ -44,8 +44,7 @@ MeshSource readMeshSource(ElementReader& in) {
           fmt::format("the mesh would have {:.3g} cells; at most {:.0f} are generated", cells, kLargestGeneratedMesh));
   };
   if (source.kind == "lblock") {
-    source.level = in.count("level", 1, 1000);
-    if (source.level < 1) in.fail("level must be at least 1");
+    source.level = in.count("level", 1, 1, 1000);
     checkSize(kLBlockCells * std::pow(source.level, 3));
   } else if (source.kind == "box") {
     source.origin = in.vector("origin", Vec3::Zero());
@@ -253,6 +252,7 @@ void buildPrescribedMotion(ElementReader& in, SceneBuild& build, MotionKind kind
   // the initial velocity that the motion starts with
   const Vec3 startVelocity = amplitude * (displacement ? profile.slope(0.0) : profile(0.0));
   std::vector<PrescribedMotion>& motions = build.prescribedMotions;
+  const std::string declaredAt = in.where() + ": <" + in.tag() + ">";
   for (int node : nodes)
     for (char direction : directions) {
       const int k = direction - 'x';
@@ -265,8 +265,8 @@ void buildPrescribedMotion(ElementReader& in, SceneBuild& build, MotionKind kind
         in.fail("node " + std::to_string(node) + " of '" + solid.name + "' already has a prescribed motion in " +
                 direction);
       }
-      motions.push_back(
-          {dof, amplitude[k], profile, displacement ? PrescribedKind::Displacement : PrescribedKind::Velocity});
+      motions.push_back({dof, amplitude[k], profile,
+                         displacement ? PrescribedKind::Displacement : PrescribedKind::Velocity, declaredAt});
       build.state[dof] = startVelocity[k];
     }
 }

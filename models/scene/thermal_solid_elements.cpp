@@ -86,7 +86,8 @@ void buildPrescribedTemperature(ElementReader& in, SceneBuild& build, DofRange&)
     const int dof = solid.thermalDofs[node];
     if (hasPrescribedTemperature(build, dof))
       in.fail(fmt::format("node {} of '{}' already has a prescribed temperature", node, solid.name));
-    build.prescribedMotions.push_back({dof, temperature, profile, PrescribedKind::Temperature});
+    build.prescribedMotions.push_back(
+        {dof, temperature, profile, PrescribedKind::Temperature, in.where() + ": <" + in.tag() + ">"});
     build.state[dof] = temperature * profile(0.0);
   }
 }

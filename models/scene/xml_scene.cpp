@@ -29,6 +29,7 @@ ElementSpec toSpec(const XMLElement& element, const std::string& label, int inde
 void readSimulation(ElementReader& in, SceneSettings& settings) {
   settings.dt = in.positive("dt");
   settings.tEnd = in.positive("t_end");
+  checkStepCount(settings.tEnd, settings.dt, in.where() + ": <simulation>");
   settings.integrator = in.text("integrator", "eem");
   const std::optional<Method> method = methodByName(settings.integrator);
   if (!method) in.fail("unknown integrator '" + settings.integrator + "' (choose " + kMethodNames + ")");
@@ -55,14 +56,13 @@ void readSolver(ElementReader& in, NewtonSettings& n) {
   n.incrementTolerance = in.positive("increment_tolerance", n.incrementTolerance);
   n.residualTolerance = in.positive("residual_tolerance", n.residualTolerance);
   // more halvings than 50 take the step below 1e-15 of itself
-  n.maxIterations = in.count("max_iterations", n.maxIterations, 10000);
-  n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks, 50);
+  n.maxIterations = in.count("max_iterations", n.maxIterations, 1, 10000);
+  n.maxCutbacks = in.count("max_cutbacks", n.maxCutbacks, 0, 50);
   n.predictor = in.flag("predictor", n.predictor);
   n.reuseContraction = in.nonNegative("reuse_contraction", n.reuseContraction);
   n.reuseBelowIncrement = in.nonNegative("reuse_below_increment", n.reuseBelowIncrement);
   n.symmetricFactorisation = in.flag("symmetric_factorisation", n.symmetricFactorisation);
   n.corotate = in.flag("corotate", n.corotate);
-  if (n.maxIterations < 1) in.fail("max_iterations must be at least 1");
   if (!(n.reuseContraction < 1.0)) in.fail("reuse_contraction must be below 1 (0: full Newton)");
   if (n.symmetricFactorisation && n.reuseContraction == 0.0)
     in.fail("symmetric_factorisation approximates the tangent: it needs simplified Newton (reuse_contraction > 0)");
