@@ -188,14 +188,17 @@ void QuadraticConstraint::stageResiduals(const StageArgs& args, Workspace&, Loca
 // The step's path at the points of the fine rule, which every form and stage share.
 struct QuadraticConstraint::StagePath {
   ConstraintVector q[CollocationRule::kFinePoints], rate[CollocationRule::kFinePoints];  // positions, tau-rates
-  ConstraintVector end;                                                                  // positions at the step's end
+  // the line through the stages' positions (q's projection onto linear functions of tau), where
+  // the multipliers' forces take grad Phi
+  ConstraintVector line[CollocationRule::kFinePoints];
+  ConstraintVector start, end;  // positions at the step's start and end
   // each stage's test function times the fine rule's weight, over the stage's Gauss weight
   double testWeight[CollocationRule::kFinePoints][CollocationRule::kMostStages];
 };
 
 // One form's Galerkin projections onto the stages' test functions, exact for these polynomial
-// integrands: the force (lambda + kappa Phi) grad Phi (on the form's support) and, for lambda's
-// row, the rate of Phi; with a tangent (one stage at a time) the n x n block, the Hessian's share
+// integrands: the constraint force (on the form's support) and, for lambda's row, the rate of
+// Phi; with a tangent (one stage at a time) the n x n block, the Hessian's share
 // of it summed over the points before it multiplies H, lambda's column and row.
 struct QuadraticConstraint::StageProjection {
   bool lambdaUnknown = false;  // lambda_k is a stagewise linear unknown
@@ -219,15 +222,16 @@ QuadraticConstraint::StagePath QuadraticConstraint::stagePath(const StageArgs& a
   StagePath path;
   // the basis points of the step's polynomial: the start, then each stage
   ConstraintVector basis[CollocationRule::kMostStages + 1];
-  basis[0] = gather(args.zOld, 0);
+  basis[0] = path.start = gather(args.zOld, 0);
   for (int j = 0; j < rule.stages; ++j) basis[j + 1] = gather(args.stageState[j], 0);
   path.end = gather(args.zEnd, 0);
   for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
-    path.q[p] = path.rate[p] = ConstraintVector::Zero(n);
+    path.q[p] = path.rate[p] = path.line[p] = ConstraintVector::Zero(n);
     for (int j = 0; j <= rule.stages; ++j) {
       path.q[p] += rule.fineValue[p][j] * basis[j];
       path.rate[p] += rule.fineRate[p][j] * basis[j];
     }
+    for (int j = 0; j < rule.stages; ++j) path.line[p] += rule.fineStage[p][j] * basis[j + 1];
     for (int i = 0; i < count; ++i) {
       const int l = firstStage + i;
       path.testWeight[p][i] = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];
@@ -243,37 +247,59 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
   const QuadraticForm& form = spec_.forms[k];
   StageProjection out;
   out.lambdaUnknown = lambdaUnknown(k);
-  double lambda[CollocationRule::kMostStages] = {};
-  if (out.lambdaUnknown)
-    for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
   const int supportSize = static_cast<int>(form.supportCoordinates().size());
   for (int i = 0; i < count; ++i) std::fill_n(out.force[i].begin(), supportSize, 0.0);
   if (args.tangent) {
     out.dForce.setZero(n, n);
     out.dForceDLambda = out.rateRow = ConstraintVector::Zero(n);
   }
+  // With a multiplier, the force (lambda + kappa (Phi_0 + Phi_end) / 2) grad Phi takes grad Phi on
+  // the stages' line y, whose moment y x grad Phi(y) vanishes pointwise for a rotation-invariant
+  // Phi; the penalty's mean over the step's ends is its discrete gradient in Phi. A penalty alone
+  // takes kappa Phi grad Phi on the path, whose change of kappa/2 Phi^2 is exact (section 13.7).
+  double lambda[CollocationRule::kMostStages] = {}, meanPenalty = 0.0;
+  SupportValues endGradient{};
+  if (out.lambdaUnknown) {
+    for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
+    const double phiEnd = form.valueAndSupportGradient(path.end, endGradient);
+    meanPenalty = 0.5 * spec_.stiffness * (form.valueAt(path.start) + phiEnd);
+  }
+  ConstraintVector lineForce = args.tangent ? ConstraintVector::Zero(n) : ConstraintVector();
   for (int p = 0; p < CollocationRule::kFinePoints; ++p) {
-    const ConstraintVector &q = path.q[p], &rate = path.rate[p];
-    double multiplier = 0.0;
-    for (int j = 0; j < rule.stages; ++j) multiplier += rule.fineStage[p][j] * lambda[j];
-    SupportValues supportGradient;
-    const double phi = form.valueAndSupportGradient(q, supportGradient);
-    const double value = multiplier + spec_.stiffness * phi;
-    const double rateOfPhiHere = out.lambdaUnknown ? form.dotOnSupport(supportGradient, rate) : 0.0;
-    const ConstraintVector gradient = args.tangent ? form.fromSupport(supportGradient) : ConstraintVector();
+    double value = meanPenalty;
+    for (int j = 0; j < rule.stages; ++j) value += rule.fineStage[p][j] * lambda[j];
+    SupportValues gradientHere;
+    if (out.lambdaUnknown)
+      form.valueAndSupportGradient(path.line[p], gradientHere);
+    else
+      value = spec_.stiffness * form.valueAndSupportGradient(path.q[p], gradientHere);
+    const double rateOfPhiHere = out.lambdaUnknown ? form.dotOnSupport(gradientHere, path.rate[p]) : 0.0;
+    const ConstraintVector gradient = args.tangent ? form.fromSupport(gradientHere) : ConstraintVector();
     for (int i = 0; i < count; ++i) {
       const double test = path.testWeight[p][i];
-      for (int s = 0; s < supportSize; ++s) out.force[i][s] += (test * value) * supportGradient[s];
+      for (int s = 0; s < supportSize; ++s) out.force[i][s] += (test * value) * gradientHere[s];
       out.rateOfPhi[i] += test * rateOfPhiHere;
       if (!args.tangent) continue;
-      const double valueCoefficient = rule.fineValue[p][column + 1];
-      out.hessianWeight += test * valueCoefficient * value;
-      out.dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
-      if (!out.lambdaUnknown) continue;
-      out.dForceDLambda += (test * rule.fineStage[p][column]) * gradient;
-      out.rateRow += test * (valueCoefficient * form.hessianTimes(rate) + rule.fineRate[p][column + 1] * gradient);
+      if (!out.lambdaUnknown) {
+        // d q / d Z_column at this point
+        const double valueCoefficient = rule.fineValue[p][column + 1];
+        out.hessianWeight += test * valueCoefficient * value;
+        out.dForce.noalias() += (test * valueCoefficient * spec_.stiffness) * gradient * gradient.transpose();
+        continue;
+      }
+      // d y / d Z_column at this point
+      const double lineCoefficient = rule.fineStage[p][column];
+      out.hessianWeight += test * lineCoefficient * value;
+      out.dForceDLambda += (test * lineCoefficient) * gradient;
+      out.rateRow +=
+          test * (lineCoefficient * form.hessianTimes(path.rate[p]) + rule.fineRate[p][column + 1] * gradient);
+      lineForce += test * gradient;
     }
   }
+  // the mean penalty's change with the step's end
+  if (args.tangent && out.lambdaUnknown)
+    out.dForce.noalias() +=
+        (0.5 * spec_.stiffness * rule.end[column + 1]) * lineForce * form.fromSupport(endGradient).transpose();
   return out;
 }
 
@@ -304,9 +330,10 @@ void QuadraticConstraint::addFormRows(std::size_t k, const StageProjection& proj
       continue;
     }
     if (args.tangent) K.block(n, lambdaRow, n, 1) += projection.dForceDLambda;
-    // lambda's rows: Phi(q_end) = 0 at the first stage, the rate of Phi tested with the later
-    // stages' test functions; the constraint forces then do the work lambda_1 (Phi(q_end) -
-    // Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
+    // lambda's rows: Phi(q_end) = 0 at the first stage, grad Phi(y) . q' tested with the later
+    // stages' test functions. Its integral over the step is Phi(q_end) - Phi(q_0) (q - y is a
+    // multiple of the second Legendre polynomial, orthogonal to the linear H q'), so the forces
+    // do the work lambda_1 (Phi(q_end) - Phi(q_0)) = 0 over the step (docs/theory.md section 13.7)
     if (l == 0) {
       SupportValues gradientEnd;
       r[lambdaRow] = form.valueAndSupportGradient(path.end, gradientEnd);

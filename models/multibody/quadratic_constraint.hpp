@@ -13,7 +13,8 @@
 // block is algebraic for IDA). In an eem4 step (docs/theory.md section 13.7) lambda is linear
 // over the step (a value per stage); the forces and the rate of Phi are projected onto the
 // stages' test functions with a quadrature exact for their polynomial integrands, so that the
-// constraint forces do no work over the step and the penalty energy's change is exact.
+// constraint forces do no work over the step and the penalty energy's change is exact, and,
+// with grad Phi taken on the line through the stage positions, exert no moment.
 #include "engine/core/component.hpp"
 #include "models/multibody/quadratic_form.hpp"
 
