@@ -126,14 +126,31 @@ TEST_F(CliTest, ACheckpointOfAnotherRunIsRefused) {
   EXPECT_EQ(other.exitCode, kExitInvalidInput);
   EXPECT_NE(other.err.find("another scene"), std::string::npos) << other.err;
 
-  // a damaged file: its line and what is wrong
-  std::string text = readFile(first / "checkpoint.txt");
-  text.replace(text.find("\ntime "), 6, "\ntime x");
-  std::ofstream(dir_ / "damaged.txt") << text;
-  const Invocation damaged =
-      metriplex("run " + kScene + " --restart " + quoted(dir_ / "damaged.txt") + " --out " + quoted(outDir()));
-  EXPECT_EQ(damaged.exitCode, kExitInvalidInput);
-  EXPECT_NE(damaged.err.find("damaged.txt:13: 'x"), std::string::npos) << damaged.err;
+  // a damaged file: its line and what is wrong, before anything is written (a value that is no
+  // number, not finite, out of its range, or followed by more text)
+  const std::string text = readFile(first / "checkpoint.txt");
+  struct Damage {
+    std::string field, replacement, message;
+  };
+  const Damage damages[] = {
+      {"time", "x", "'x' is not a finite number"},
+      {"time", "-1", "'time' must not be negative"},
+      {"time", "5 junk", "unexpected 'junk' after the value of 'time'"},
+      {"initial_energy", "nan", "'nan' is not a finite number"},
+      {"energy_scale", "-5", "'energy_scale' must not be negative"},
+      {"error_history_count", "99", "'error_history_count' must be 0 to 5"},
+  };
+  for (const Damage& d : damages) {
+    const std::size_t start = text.find("\n" + d.field + " ") + 1, end = text.find('\n', start);
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + start, '\n'));
+    std::ofstream(dir_ / "damaged.txt") << text.substr(0, start) + d.field + " " + d.replacement + text.substr(end);
+    const Invocation damaged =
+        metriplex("run " + kScene + " --restart " + quoted(dir_ / "damaged.txt") + " --out " + quoted(outDir()));
+    EXPECT_EQ(damaged.exitCode, kExitInvalidInput) << d.field << " " << d.replacement;
+    const std::string where = "damaged.txt:" + std::to_string(line) + ": " + d.message;
+    EXPECT_NE(damaged.err.find(where), std::string::npos) << where << " in " << damaged.err;
+    EXPECT_FALSE(fs::exists(outDir())) << d.field << " " << d.replacement;
+  }
 }
 
 // Frame outputs after a restart: the checkpoint's row, then the whole run's output times only

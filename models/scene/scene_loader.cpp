@@ -6,6 +6,10 @@
 #include "models/scene/urdf_scene.hpp"
 #include "models/scene/xml_scene.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -68,6 +72,25 @@ void setMechanicalScales(SceneBuild& build, double tEnd) {
   }
 }
 
+// The initial state must give finite measures and positive temperatures: a value that overflows
+// (a mass of 1e308 moving at 1e308) or an entropy beyond what a capacity's temperature can
+// represent would otherwise only fail in the first step. Names the element whose measure fails.
+void checkInitialState(const Model& model, const SceneSpec& scene,
+                       const std::map<const Component*, std::size_t>& elementIndex) {
+  for (const auto& component : model.components()) {
+    Measures own;
+    own.nodeTemperature.assign(model.thermalNodeNames().size(), 1.0);
+    component->measure(model.initialState().data(), own);
+    const bool temperaturesPositive = std::all_of(own.nodeTemperature.begin(), own.nodeTemperature.end(),
+                                                  [](double t) { return t > 0.0 && std::isfinite(t); });
+    if (std::isfinite(own.energy) && std::isfinite(own.entropy) && temperaturesPositive) continue;
+    ElementReader(scene.elements[elementIndex.at(component.get())])
+        .fail(fmt::format("the initial state gives energy {:.3g}, entropy {:.3g} or a temperature that is not finite "
+                          "and positive",
+                          own.energy, own.entropy));
+  }
+}
+
 }  // namespace
 
 CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable> thermalVariable) {
@@ -88,7 +111,7 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
   build.allocate(layoutOf(demands, firsts));
 
   // pass 2: every element builds from the dofs it declared, and takes all of them
-  std::map<const Component*, std::string> elementOf;
+  std::map<const Component*, std::size_t> elementIndex;
   for (std::size_t k = 0; k < scene.elements.size(); ++k) {
     ElementReader in(scene.elements[k]);
     DofRange dofs(build.layout, firsts[k], demands[k]);
@@ -96,9 +119,7 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
     kinds[k]->build(in, build, dofs);
     in.finish();
     dofs.checkAllTaken(in.where() + ": <" + in.tag() + ">");
-    const std::string* name = scene.elements[k].find("name");
-    for (std::size_t c = before; c < build.components.size(); ++c)
-      elementOf[build.components[c].get()] = name ? *name : scene.elements[k].tag;
+    for (std::size_t c = before; c < build.components.size(); ++c) elementIndex[build.components[c].get()] = k;
   }
   if (build.layout.total() == 0)
     throw InputError(SourceLocation{scene.label, scene.line, 0}.describe() +
@@ -109,9 +130,14 @@ CompiledScene compileScene(const SceneSpec& scene, std::optional<ThermalVariable
   auto model = std::make_unique<Model>(build.layout, build.variable, std::move(build.components),
                                        build.thermalNodeNames, build.state, build.scale,
                                        std::move(build.prescribedMotions), std::move(build.loadBreakpoints));
+  checkInitialState(*model, scene, elementIndex);
   // the model evaluates couplings last: its order, not the build's
   std::vector<std::string> componentElements;
-  for (const auto& component : model->components()) componentElements.push_back(elementOf.at(component.get()));
+  for (const auto& component : model->components()) {
+    const ElementSpec& element = scene.elements[elementIndex.at(component.get())];
+    const std::string* name = element.find("name");
+    componentElements.push_back(name ? *name : element.tag);
+  }
   return {scene.name,
           scene.settings,
           std::move(model),

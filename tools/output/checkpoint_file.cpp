@@ -6,8 +6,10 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace mpx {
@@ -84,11 +86,14 @@ class FieldReader {
  public:
   FieldReader(std::string path, const std::string& text) : path_(std::move(path)), text_(text) {}
 
-  void operator()(const std::string& key, std::string& value) { value = word(next(key)); }
-  void operator()(const std::string& key, bool& value) { value = integer(next(key), 0, 1) == 1; }
-  void operator()(const std::string& key, int& value) { value = static_cast<int>(integer(next(key), 0, INT32_MAX)); }
-  void operator()(const std::string& key, long& value) { value = integer(next(key), 0, INT64_MAX); }
-  void operator()(const std::string& key, double& value) { value = number(next(key)); }
+  void operator()(const std::string& key, std::string& value) { value = word(next(key)), endOfLine(key); }
+  void operator()(const std::string& key, bool& value) { value = integer(next(key), 0, 1) == 1, endOfLine(key); }
+  void operator()(const std::string& key, int& value) {
+    value = static_cast<int>(integer(next(key), 0, INT32_MAX));
+    endOfLine(key);
+  }
+  void operator()(const std::string& key, long& value) { value = integer(next(key), 0, INT64_MAX), endOfLine(key); }
+  void operator()(const std::string& key, double& value) { value = number(next(key)), endOfLine(key); }
   // a state vector holds every dof, or none (fixed steps keep no error history)
   void operator()(const std::string& key, Eigen::VectorXd& values) {
     std::istringstream& line = next(key);
@@ -96,9 +101,14 @@ class FieldReader {
     if (values.size() != 0 && values.size() != dofs)
       fail(fmt::format("'{}' has {} values; the scene has {} dofs", key, values.size(), dofs));
     for (double& v : values) v = number(line);
+    endOfLine(key);
   }
   int dofs = 0;  // set once the identity is read
   void fail(const std::string& what) const { throw InputError(path_, line_, what); }
+  // a field read earlier is out of its range: name its line
+  void failAt(const std::string& key, const std::string& what) const {
+    throw InputError(path_, lines_.at(key), "'" + key + "' " + what);
+  }
   void finish() {
     std::string rest;
     if (std::getline(text_, rest)) ++line_, fail("unexpected line after the last field");
@@ -116,7 +126,12 @@ class FieldReader {
     std::string found;
     current_ >> found;
     if (found != key) fail("expected field '" + key + "', found '" + found.substr(0, 40) + "'");
+    lines_[key] = line_;
     return current_;
+  }
+  void endOfLine(const std::string& key) {
+    std::string extra;
+    if (current_ >> extra) fail("unexpected '" + extra.substr(0, 40) + "' after the value of '" + key + "'");
   }
   std::string word(std::istringstream& line) {
     std::string value;
@@ -140,7 +155,8 @@ class FieldReader {
     const std::string text = word(line);
     char* end = nullptr;
     const double value = std::strtod(text.c_str(), &end);
-    if (end != text.c_str() + text.size()) fail("'" + text.substr(0, 40) + "' is not a number");
+    if (end != text.c_str() + text.size() || !std::isfinite(value))
+      fail("'" + text.substr(0, 40) + "' is not a finite number");
     return value;
   }
 
@@ -148,6 +164,7 @@ class FieldReader {
   std::istringstream text_;
   std::istringstream current_;
   int line_ = 0;
+  std::map<std::string, int> lines_;  // where each field was read
 };
 
 }  // namespace
@@ -197,11 +214,21 @@ LoopState readCheckpoint(const std::string& path, const CheckpointIdentity& expe
           fmt::format("output interval (--output-interval {:.17g}, where adaptive steps land)", found.outputInterval));
   LoopState state;
   visitState(state, reader);
-  if (state.errorHistoryCount < 0 || state.errorHistoryCount > LoopState::kMostErrorHistory)
-    throw InputError(fmt::format("{}: error_history_count must be 0 to {}", path, LoopState::kMostErrorHistory));
   reader.finish();
-  if (state.state.size() == 0 || state.predictorStart.size() == 0 || state.predictorEnd.size() == 0)
-    throw InputError(path + ": the state or the predictor's states are empty");
+  // what a run writes: times, steps and scales are not negative, the states are whole
+  if (state.errorHistoryCount > LoopState::kMostErrorHistory)
+    reader.failAt("error_history_count", fmt::format("must be 0 to {}", LoopState::kMostErrorHistory));
+  for (const auto& [key, value] : {std::pair<const char*, double>{"time", state.time},
+                                   {"dt_last", state.dt},
+                                   {"energy_scale", state.energyScale},
+                                   {"predictor_time", state.predictorTime},
+                                   {"predictor_dt", state.predictorDt},
+                                   {"proposed_step", state.proposedStep}})
+    if (value < 0.0) reader.failAt(key, "must not be negative");
+  for (const auto& [key, values] : {std::pair<const char*, const Eigen::VectorXd*>{"state", &state.state},
+                                    {"predictor_start", &state.predictorStart},
+                                    {"predictor_end", &state.predictorEnd}})
+    if (values->size() == 0) reader.failAt(key, "is empty");
   return state;
 }
 
