@@ -85,6 +85,18 @@ void buildJoint(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   const std::optional<JointType> type = jointTypeByName(typeName);
   if (!type) in.fail("unknown joint type '" + typeName + "' (choose " + kJointTypeNames + ")");
   const Attachment a = build.attachment(in, "a"), b = build.attachment(in, "b");
+  // an attribute another joint type reads is an error here, not silently ignored
+  const bool revoluteOrPrismatic = *type == JointType::Revolute || *type == JointType::Prismatic;
+  const bool axial = revoluteOrPrismatic || *type == JointType::Universal || *type == JointType::Cylindrical ||
+                     *type == JointType::Planar;
+  auto onlyFor = [&](const char* attribute, bool applies, const char* types) {
+    if (!applies && in.has(attribute))
+      in.fail(std::string("attribute '") + attribute + "' applies to " + types + " joints only, not " + typeName);
+  };
+  onlyFor("axis", axial, "revolute, universal, cylindrical, prismatic and planar");
+  onlyFor("axis_b", *type == JointType::Universal, "universal");
+  onlyFor("anchor_b", *type == JointType::Distance, "distance");
+  onlyFor("coordinate", revoluteOrPrismatic, "revolute and prismatic");
   JointGeometry geometry;
   geometry.anchor = in.vector("anchor", b.position);
   geometry.anchorB = in.vector("anchor_b", b.position);
@@ -171,6 +183,7 @@ void buildJointForce(ElementReader& in, SceneBuild& build, DofRange& dofs) {
   spec.damping = in.nonNegative("damping", 0.0);
   spec.friction = in.nonNegative("friction", 0.0);
   spec.frictionVelocity = in.positive("friction_velocity", 1e-2);
+  if (in.has("friction_velocity") && !(spec.friction > 0.0)) in.fail("friction_velocity needs friction > 0");
   if (in.has("heat_node")) {
     const ThermalNodeRef node = build.thermalNode(in, "heat_node");
     if (node.thermalDof < 0) in.fail("heat_node must have a heat capacity (not a fixed temperature)");

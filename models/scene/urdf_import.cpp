@@ -448,11 +448,11 @@ void UrdfTranslator::addDynamics(const urdf::Joint& joint) {
     ignoredDynamics_.push_back(joint.name);
     return;
   }
-  emit("joint_force", joint.name + ".damping", "joint", joint.name)
-      .set("joint", sceneName(joint.name))
-      .set("damping", joint.dynamics->damping)
-      .set("friction", joint.dynamics->friction)
-      .set("friction_velocity", kFrictionVelocity);
+  auto& force = emit("joint_force", joint.name + ".damping", "joint", joint.name)
+                    .set("joint", sceneName(joint.name))
+                    .set("damping", joint.dynamics->damping)
+                    .set("friction", joint.dynamics->friction);
+  if (joint.dynamics->friction > 0.0) force.set("friction_velocity", kFrictionVelocity);
 }
 
 // Stops at the joint's position limits, in the URDF's coordinate (the scene joint's `coordinate`).
