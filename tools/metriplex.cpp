@@ -10,9 +10,9 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
-#include <sstream>
 
 namespace {
 
@@ -25,13 +25,25 @@ extern "C" void stopAtNextStep(int signal) {
 
 std::vector<std::string> splitNames(const std::string& list) {
   std::vector<std::string> names;
-  std::stringstream stream(list);
-  for (std::string name; std::getline(stream, name, ',');) {
-    // an empty name would silently stand for the scene's own integrator
+  if (list.empty()) return names;  // the command says it needs one
+  std::size_t start = 0;
+  for (std::size_t comma; start <= list.size(); start = comma + 1) {
+    comma = std::min(list.find(',', start), list.size());
+    const std::string name = list.substr(start, comma - start);
+    // an empty name would silently stand for the scene's own integrator; a repeated one would
+    // run twice into one directory
     if (name.empty()) throw InputError("option --integrators: an empty name in '" + list.substr(0, 64) + "'");
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      throw InputError("option --integrators: '" + name.substr(0, 64) + "' is named twice");
     names.push_back(name);
   }
   return names;
+}
+
+// An option given with an empty value, e.g. --out "", would silently take its default.
+void refuseEmpty(const CLI::App& command, const char* option, const std::string& value) {
+  if (command.count(option) > 0 && value.empty())
+    throw InputError(std::string("option ") + option + ": an empty value");
 }
 
 // Options every subcommand shares.
@@ -150,6 +162,8 @@ int main(int argc, char** argv) {
   // second one (while a scene loads, say) ends the program at once
   for (const int signal : {SIGINT, SIGTERM}) std::signal(signal, stopAtNextStep);
   try {
+    for (const CLI::App* command : {run, compare, benchCommandLine}) refuseEmpty(*command, "--out", request.out);
+    refuseEmpty(*run, "--restart", request.restart);
     if (run->parsed()) return runCommand(request);
     if (compare->parsed()) return compareCommand(request, splitNames(integrators));
     if (plot->parsed()) {

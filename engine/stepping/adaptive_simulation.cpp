@@ -183,6 +183,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
   // one step of the scheme, counted in the summary
   auto attempt = [&](const Eigen::VectorXd& from, double t, double dt, Eigen::VectorXd& to, StepOutcome& outcome,
                      Attempt slot) {
+    newtonFailure[0] = '\0';
     outcome = integrator.advance(from, t, dt, to, byComponent.slot(slot));
     summary.newtonIterations += outcome.iterations;
     summary.cutbacks += outcome.cutbacks;
@@ -241,7 +242,7 @@ RunSummary simulateAdaptive(const Model& model, const RunOptions& options, const
       summary.failedTime = t;
       char what[sizeof newtonFailure + 100];
       std::snprintf(what, sizeof what, "adaptive step fell below %.3g (the last one tried, %.3g, %s)", smallest, dt,
-                    std::isfinite(error) ? "failed the error test" : newtonFailure);
+                    newtonFailure[0] != '\0' ? newtonFailure : "failed the error test");
       summary.failure = what;
       break;
     }

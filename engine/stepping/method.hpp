@@ -53,6 +53,8 @@ void checkMethodSupports(const Method& method, const Model& model, const std::st
 
 // Fixed-step runs take at most this many steps (a step count must fit the step counters).
 inline constexpr double kMostSteps = 1e9;
+// Below this relative tolerance the round-off of a state exceeds what it asks of a step.
+inline constexpr double kSmallestRelativeTolerance = 1e-14;
 // Throw InputError, prefixed by `where`, if t_end / dt asks for more than kMostSteps steps.
 void checkStepCount(double tEnd, double dt, const std::string& where);
 

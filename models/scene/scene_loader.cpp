@@ -32,9 +32,9 @@ void checkSettings(const SceneSpec& scene) {
           "the simulation needs finite dt > 0 and t_end > 0");
   require(methodByName(s.integrator).has_value(), "unknown integrator '" + s.integrator + "'");
   checkStepCount(s.tEnd, s.dt, SourceLocation{scene.label, scene.line, 0}.describe() + ": <simulation>");
-  require(s.relativeTolerance > 0.0 && std::isfinite(s.relativeTolerance) && s.absoluteTolerance >= 0.0 &&
-              std::isfinite(s.absoluteTolerance),
-          "rtol must be positive and atol non-negative");
+  require(s.relativeTolerance >= kSmallestRelativeTolerance && std::isfinite(s.relativeTolerance) &&
+              s.absoluteTolerance >= 0.0 && std::isfinite(s.absoluteTolerance),
+          "rtol must be at least 1e-14 and atol non-negative");
   require(n.incrementTolerance > 0.0 && n.residualTolerance > 0.0, "Newton tolerances must be positive");
   require(n.maxIterations >= 1 && n.maxCutbacks >= 0, "max_iterations must be at least 1, max_cutbacks at least 0");
   require(n.reuseContraction >= 0.0 && n.reuseContraction < 1.0, "reuse_contraction must be in [0, 1)");

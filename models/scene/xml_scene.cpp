@@ -6,6 +6,7 @@
 
 #include "models/scene/strict_xml.hpp"
 
+#include <fmt/format.h>
 #include <tinyxml2.h>
 
 #include <filesystem>
@@ -48,7 +49,11 @@ void readSimulation(ElementReader& in, SceneSettings& settings) {
     in.fail("discrete_gradient must be 'partitioned' or 'gonzalez', got '" + form + "'");
   settings.discreteGradient = form == "gonzalez" ? DiscreteGradientForm::Gonzalez : DiscreteGradientForm::Partitioned;
   settings.adaptive = in.flag("adaptive", false);
+  if (method->adaptive && in.has("adaptive") && !settings.adaptive)
+    in.fail("integrator '" + settings.integrator + "' contradicts adaptive=\"false\"");
   settings.relativeTolerance = in.positive("rtol", settings.relativeTolerance);
+  if (settings.relativeTolerance < kSmallestRelativeTolerance)
+    in.fail(fmt::format("rtol must be at least {:g} (below, round-off exceeds it)", kSmallestRelativeTolerance));
   settings.absoluteTolerance = in.has("atol") ? in.positive("atol") : 0.0;
 }
 

@@ -82,6 +82,9 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   checkPositive(request.dt, "--dt");
   checkPositive(request.tEnd, "--t-end");
   checkPositive(request.relativeTolerance, "--rtol");
+  if (request.relativeTolerance && *request.relativeTolerance < kSmallestRelativeTolerance)
+    throw InputError(fmt::format("option --rtol must be at least {:g} (below, round-off exceeds it), got {}",
+                                 kSmallestRelativeTolerance, *request.relativeTolerance));
   checkPositive(request.absoluteTolerance, "--atol");
   checkPositive(request.outputStep, "--dt-out");
   if (request.maxOrder && (*request.maxOrder < 1 || *request.maxOrder > 5))
@@ -92,6 +95,12 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
   CompiledScene scene = request.spec ? compileScene(*request.spec, variable) : loadRequestedScene(request, variable);
   if (!method) method = methodOrThrow(scene.settings.integrator);
   checkMethodSupports(*method, *scene.model, request.scene);
+  // IDA's options with another integrator would be silently ignored
+  if (!method->isIda())
+    for (const auto& [given, option] : {std::pair<bool, const char*>{request.maxOrder.has_value(), "--max-order"},
+                                        {request.outputStep.has_value(), "--dt-out"},
+                                        {request.sundialsKlu, "--sundials-klu"}})
+      if (given) throw InputError(fmt::format("option {}: only for ida, not '{}'", option, method->name));
   if (method->maxOrder > 0 && request.maxOrder && *request.maxOrder != method->maxOrder)
     throw InputError(fmt::format("option --max-order {}: integrator '{}' sets the order to {} already",
                                  *request.maxOrder, method->name, method->maxOrder));
@@ -116,6 +125,9 @@ PreparedRun prepareRun(const RunRequest& request, const std::string& outSuffix) 
           ? std::filesystem::path("out") / (scene.name + "-" + (outSuffix.empty() ? method->name : outSuffix))
           : std::filesystem::path(request.out);
   checkPositive(request.frameInterval, "--output-interval");
+  // adaptive steps land on every output time
+  if (parameters.adaptive && request.frameInterval)
+    checkStepCount(parameters.tEnd, *request.frameInterval, "options --t-end and --output-interval");
   // IDA integrates the summed flows as quadratures; a restart has no flows per element to resume
   if (request.budget && method->isIda())
     throw InputError("option --budget: integrator 'ida' integrates only the total flows; use a one-step integrator");
