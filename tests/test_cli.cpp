@@ -394,6 +394,12 @@ TEST_F(CliTest, UnknownSubcommandAndUnusableOutputDirectoryAreNamed) {
   EXPECT_EQ(badOut.exitCode, kExitInvalidInput);
   EXPECT_NE(badOut.err.find("option --out: cannot create the directory /proc/no/such/dir"), std::string::npos)
       << badOut.err;
+  // a directory where the history is to be renamed into place: refused before the run
+  fs::create_directories(outDir() / "history.csv");
+  const Invocation blocked = metriplex("run " + quoted(writeScene(kSwingScene)) + " --out " + quoted(outDir()));
+  EXPECT_EQ(blocked.exitCode, kExitInvalidInput);
+  EXPECT_NE(blocked.err.find("history.csv exists and is not a file"), std::string::npos) << blocked.err;
+  EXPECT_FALSE(fs::exists(outDir() / "history.csv.part"));
 }
 
 // IDA's rate form cannot impose a displacement step by step: refused before anything is written,

@@ -146,6 +146,10 @@ RunResult executeRun(const PreparedRun& run, const RunOutputs& outputs) {
     if (error)
       throw InputError(
           fmt::format("option --out: cannot create the directory {}: {}", run.out.string(), error.message()));
+    // the files renamed into place at the end: a directory in their way would fail after the run
+    for (const char* name : {"history.csv", "summary.json", "checkpoint.txt"})
+      if (std::filesystem::exists(run.out / name) && !std::filesystem::is_regular_file(run.out / name))
+        throw InputError(fmt::format("option --out: {} exists and is not a file", (run.out / name).string()));
   }
   std::optional<HistoryCsv> history;
   std::optional<FramesCsv> frames;
