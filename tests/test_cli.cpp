@@ -664,6 +664,14 @@ TEST_F(CliTest, BenchWritesTheWorkPrecisionTableAndPlots) {
   const Invocation again = metriplex(command);
   ASSERT_EQ(again.exitCode, kExitSuccess) << again.err;
   EXPECT_NE(again.out.find("reference: cached"), std::string::npos) << again.out;
+  // a damaged cache (a position that is not a finite number) is computed again, not believed
+  const std::string cache = readFile(outDir() / "reference.csv");
+  const std::size_t row = cache.find('\n') + 1;
+  std::ofstream(outDir() / "reference.csv") << cache.substr(0, row) + "nan" + cache.substr(cache.find(',', row));
+  const Invocation damaged = metriplex(command);
+  ASSERT_EQ(damaged.exitCode, kExitSuccess) << damaged.err;
+  EXPECT_EQ(damaged.out.find("reference: cached"), std::string::npos) << damaged.out;
+  EXPECT_EQ(readFile(outDir() / "reference.csv"), cache);
 }
 
 // Each help text exits 0 and lists what it documents.

@@ -161,11 +161,20 @@ FinalState reference(const Model& model, const Referee& referee, const std::stri
   std::ifstream in(file);
   std::string line;
   if (std::getline(in, line) && line == "# " + key) {
-    // strtod, not >>, so that the "nan" of a scene without loads reads back
+    // strtod, not >>, so that the "nan" of a scene without loads reads back; a value that does
+    // not read whole, or a state that is not finite, leaves the cache to be computed again
     std::vector<double> values;
-    for (std::string value; std::getline(in, value, ',');) values.push_back(std::strtod(value.c_str(), nullptr));
+    bool whole = true;
+    for (std::string value; std::getline(in, value, ',');) {
+      if (!value.empty() && value.back() == '\n') value.pop_back();
+      char* end = nullptr;
+      values.push_back(std::strtod(value.c_str(), &end));
+      whole = whole && !value.empty() && end == value.c_str() + value.size();
+    }
     const Eigen::Index positions = model.layout().size(Block::Position);
-    if (values.size() == positions + model.thermalNodeNames().size() + 1) {
+    const bool finite =
+        !values.empty() && std::all_of(values.begin(), values.end() - 1, [](double v) { return std::isfinite(v); });
+    if (whole && finite && values.size() == positions + model.thermalNodeNames().size() + 1) {
       cached.positions = Eigen::Map<Eigen::VectorXd>(values.data(), positions);
       cached.temperatures.assign(values.begin() + positions, values.end() - 1);
       cached.loadEndEnergy = values.back();
