@@ -148,6 +148,18 @@ std::string malformedXml(const tinyxml2::XMLDocument& document) {
     case tinyxml2::XML_ERROR_PARSING_TEXT:
       what = "text where an element was expected";
       break;
+    case tinyxml2::XML_ERROR_PARSING:
+      what = "an element is not closed before the file ends, or a tag is cut short";
+      break;
+    case tinyxml2::XML_ERROR_PARSING_ELEMENT:
+      what = "an element's tag is malformed";
+      break;
+    case tinyxml2::XML_ERROR_PARSING_COMMENT:
+      what = "a comment is not closed";
+      break;
+    case tinyxml2::XML_ERROR_PARSING_DECLARATION:
+      what = "a declaration or processing instruction is malformed, or stands inside an element";
+      break;
     default:
       what = document.ErrorName();
   }
