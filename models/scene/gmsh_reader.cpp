@@ -16,6 +16,22 @@ namespace mpx {
 
 namespace {
 
+// A word of the file as a message quotes it: bytes outside printable ASCII as \xHH (a binary
+// file's would garble the terminal), at most 40 of them.
+std::string shown(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 40); ++i) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out += text[i];
+    } else {
+      static const char* digits = "0123456789abcdef";
+      out += std::string("\\x") + digits[byte >> 4] + digits[byte & 15];
+    }
+  }
+  return text.size() > 40 ? out + "..." : out;
+}
+
 // What Gmsh element types are: nodes per element and dimension (the first- and second-order types 1..19).
 struct ElementKind {
   int nodes;
@@ -86,7 +102,7 @@ class SectionReader {
     errno = 0;
     char* end = nullptr;
     const long long value = std::strtoll(token.text.c_str(), &end, 10);
-    if (*end || errno) fail(token.line, "expected " + what + " (an integer), found '" + token.text + "'");
+    if (*end || errno) fail(token.line, "expected " + what + " (an integer), found '" + shown(token.text) + "'");
     return value;
   }
 
@@ -100,7 +116,7 @@ class SectionReader {
     const Token& token = next(what);
     char* end = nullptr;
     const double value = std::strtod(token.text.c_str(), &end);
-    if (*end) fail(token.line, "expected " + what + " (a number), found '" + token.text + "'");
+    if (*end) fail(token.line, "expected " + what + " (a number), found '" + shown(token.text) + "'");
     if (!std::isfinite(value)) fail(token.line, what + " is '" + token.text + "', not a finite number");
     return value;
   }
@@ -108,7 +124,7 @@ class SectionReader {
   std::string quoted(const std::string& what) {
     const Token& token = next(what);
     if (token.text.size() < 2 || token.text.front() != '"' || token.text.back() != '"')
-      fail(token.line, "expected " + what + " in double quotes, found '" + token.text + "'");
+      fail(token.line, "expected " + what + " in double quotes, found '" + shown(token.text) + "'");
     return token.text.substr(1, token.text.size() - 2);
   }
 
@@ -166,7 +182,7 @@ class GmshParser {
     for (int l = 0; l < lineCount; ++l) {
       const std::string header = trimmed(lines_[l]);
       if (header.empty()) continue;
-      if (header[0] != '$') fail(l + 1, "expected a section header such as $Nodes, found '" + header + "'");
+      if (header[0] != '$') fail(l + 1, "expected a section header such as $Nodes, found '" + shown(header) + "'");
       const std::string name = header.substr(1);
       if (version_ == 0 && name != "MeshFormat") fail(l + 1, "the file must start with $MeshFormat, found " + header);
       const int end = sectionEnd(name, l);

@@ -118,7 +118,10 @@ class FieldReader {
   std::istringstream& next(const std::string& key) {
     std::string line;
     do {
-      if (!std::getline(text_, line)) fail("the file ends before field '" + key + "'");
+      if (!std::getline(text_, line)) {
+        if (line_ == 0) ++line_, fail("the file is empty");
+        fail("the file ends before field '" + key + "'");
+      }
       ++line_;
     } while (!line.empty() && line[0] == '#');
     current_.clear();
