@@ -41,13 +41,14 @@ struct StagePath {
 // of 1e-5 per step.
 inline constexpr double kStagePathFloor = 1e-10;
 
-// A norm N with the floor: N + k^2 / (N + k), and its derivative with respect to N.
+// A norm N with the floor: N + k^2 / (N + k), and its derivative with respect to N (k: this
+// floor, or a smaller one where the defect's round-off is in proportion to the motion).
 struct FlooredNorm {
   double value, slope;
 };
-inline FlooredNorm flooredNorm(double norm) {
-  const double floorRatio = kStagePathFloor / (norm + kStagePathFloor);
-  return {norm + kStagePathFloor * floorRatio, 1.0 - floorRatio * floorRatio};
+inline FlooredNorm flooredNorm(double norm, double floor = kStagePathFloor) {
+  const double floorRatio = floor / (norm + floor);
+  return {norm + floor * floorRatio, 1.0 - floorRatio * floorRatio};
 }
 
 // What D psi needs of psi along a path for every stage and column: the metric G, psi's jets at

@@ -16,7 +16,7 @@ DiscreteStress::DiscreteStress(const HyperelasticMaterial& material, const Mat3&
   if (tiny_) return;
 
   // the Gonzalez correction along dC restores directionality; G uses A:dS[B] = B:dS[A] of hyperelastic tangents
-  const double defect = material.energyDifference(C0, C1) - 0.5 * stress_.cwiseProduct(delta_).sum();
+  const double defect = material.energyDifference(C0, delta_) - 0.5 * stress_.cwiseProduct(delta_).sum();
   kappa_ = defect / squaredDelta_;
   // the numerator's gradient serves the increment only (a stress and a tangent evaluation)
   if (withIncrement)

@@ -48,9 +48,9 @@ Mat3 SaintVenantKirchhoff::stressIncrement(const Mat3&, const Mat3& dC) const {
   return quadraticStress(lame_, 0.5 * dC);
 }
 
-// With A = E1 + E0 and dE = (C1 - C0)/2: lambda/2 tr(dE) tr(A) + mu dE:A.
-double SaintVenantKirchhoff::energyDifference(const Mat3& C0, const Mat3& C1) const {
-  const Mat3 strainSum = greenStrain(C0) + greenStrain(C1), strainDifference = 0.5 * (C1 - C0);
+// With dE = dC/2 and A = E1 + E0 = 2 E0 + dE: lambda/2 tr(dE) tr(A) + mu dE:A.
+double SaintVenantKirchhoff::energyDifference(const Mat3& C0, const Mat3& dC) const {
+  const Mat3 strainDifference = 0.5 * dC, strainSum = 2.0 * greenStrain(C0) + strainDifference;
   return 0.5 * lame_.lambda * strainDifference.trace() * strainSum.trace() +
          lame_.mu * strainDifference.cwiseProduct(strainSum).sum();
 }
@@ -70,17 +70,15 @@ Mat3 adjugate(const Mat3& m) {
 
 // ln J1 - ln J0 = ln(1 + (det C1 - det C0)/det C0)/2, the determinant difference expanded in
 // D = C1 - C0: det(C0 + D) - det C0 = tr(adj(C0) D) + tr(C0 adj(D)) + det D.
-double logJacobianChange(const Mat3& C0, const Mat3& C1) {
-  const Mat3 D = C1 - C0;
+double logJacobianChange(const Mat3& C0, const Mat3& D) {
   const double det0 = C0.determinant();
   const double detDifference = (adjugate(C0) * D).trace() + (C0 * adjugate(D)).trace() + D.determinant();
   if (!(det0 > 0.0) || !(det0 + detDifference > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   return 0.5 * std::log1p(detDifference / det0);
 }
 
-double NeoHooke::energyDifference(const Mat3& C0, const Mat3& C1) const {
-  const Mat3 D = C1 - C0;
-  const double logJ0 = logJacobian(C0), logJChange = logJacobianChange(C0, C1);
+double NeoHooke::energyDifference(const Mat3& C0, const Mat3& D) const {
+  const double logJ0 = logJacobian(C0), logJChange = logJacobianChange(C0, D);
   return 0.5 * lame_.mu * D.trace() - lame_.mu * logJChange +
          0.5 * lame_.lambda * logJChange * (2.0 * logJ0 + logJChange);
 }
@@ -118,8 +116,8 @@ Mat3 VolumeLogarithm::stressIncrement(const Mat3& C, const Mat3& dC) const {
   return -coefficient_ * inverse * dC * inverse;
 }
 
-double VolumeLogarithm::energyDifference(const Mat3& C0, const Mat3& C1) const {
-  return coefficient_ * logJacobianChange(C0, C1);
+double VolumeLogarithm::energyDifference(const Mat3& C0, const Mat3& dC) const {
+  return coefficient_ * logJacobianChange(C0, dC);
 }
 
 double ViscousBranch::energy(const Mat3& C, const Mat3& Gamma) const {

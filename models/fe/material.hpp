@@ -29,9 +29,10 @@ class HyperelasticMaterial {
   virtual Mat3 stress(const Mat3& C) const = 0;
   // directional derivative dS(C)[dC] (dC symmetric)
   virtual Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const = 0;
-  // W(C1) - W(C0) computed from C1 - C0 without cancellation: its error is round-off of the
-  // difference, not of W, which the Gonzalez quotient divides by |C1 - C0|^2.
-  virtual double energyDifference(const Mat3& C0, const Mat3& C1) const = 0;
+  // W(C0 + dC) - W(C0) from the change dC without cancellation: its error is round-off of the
+  // difference, not of W, which the Gonzalez quotient divides by |dC|^2. A dC computed from the
+  // change of F (not as C1 - C0) carries no round-off of C either.
+  virtual double energyDifference(const Mat3& C0, const Mat3& dC) const = 0;
 };
 
 // W = lambda/2 (tr E)^2 + mu E:E, E = (C - I)/2
@@ -41,7 +42,7 @@ class SaintVenantKirchhoff final : public HyperelasticMaterial {
   double energy(const Mat3& C) const override;
   Mat3 stress(const Mat3& C) const override;
   Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
-  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
+  double energyDifference(const Mat3& C0, const Mat3& dC) const override;
 
  private:
   LameParameters lame_;
@@ -55,7 +56,7 @@ class NeoHooke final : public HyperelasticMaterial {
   double energy(const Mat3& C) const override;
   Mat3 stress(const Mat3& C) const override;
   Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
-  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
+  double energyDifference(const Mat3& C0, const Mat3& dC) const override;
 
  private:
   LameParameters lame_;
@@ -69,14 +70,14 @@ class VolumeLogarithm final : public HyperelasticMaterial {
   double energy(const Mat3& C) const override;
   Mat3 stress(const Mat3& C) const override;
   Mat3 stressIncrement(const Mat3& C, const Mat3& dC) const override;
-  double energyDifference(const Mat3& C0, const Mat3& C1) const override;
+  double energyDifference(const Mat3& C0, const Mat3& dC) const override;
 
  private:
   double coefficient_;
 };
 
-// ln J1 - ln J0 without cancellation (NaN unless both determinants are positive).
-double logJacobianChange(const Mat3& C0, const Mat3& C1);
+// ln J(C0 + dC) - ln J(C0) without cancellation (NaN unless both determinants are positive).
+double logJacobianChange(const Mat3& C0, const Mat3& dC);
 
 // Thermal constants of a thermoelastic solid (docs/theory.md section 9): free energy per reference volume
 //   Psi(C, theta) = W(C) - 3 beta K (theta - theta_R) ln J + kappa [theta - theta_R - theta ln(theta/theta_R)],

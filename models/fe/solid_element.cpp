@@ -321,7 +321,7 @@ void SolidElement::eemLocal(const StepArgs& args, Workspace&, LocalSystem& out, 
       e.couplingStress = coupling->stress();
       couplingShift = spec_.thermal->referenceTemperature - e.temperature;
       e.stress += couplingShift * e.couplingStress;
-      e.entropyRate = coupling_->energyDifference(C0, C1) / args.dt;
+      e.entropyRate = coupling_->energyDifference(C0, C1 - C0) / args.dt;
       entropyRateGradient = spec_.thermal->couplingModulus() / args.dt * F1.inverse();
     }
     setFluidity(e);
