@@ -135,34 +135,20 @@ void rejectText(const tinyxml2::XMLDocument& document, const std::string& label)
 
 // What tinyxml2 found wrong, in words for its common errors, with the element it was in.
 std::string malformedXml(const tinyxml2::XMLDocument& document) {
-  const char* what = nullptr;
-  switch (document.ErrorID()) {
-    case tinyxml2::XML_ERROR_EMPTY_DOCUMENT:
-      return "the file is empty (no XML element)";
-    case tinyxml2::XML_ERROR_PARSING_ATTRIBUTE:
-      what = "an attribute is not name=\"value\", or is given twice";
-      break;
-    case tinyxml2::XML_ERROR_MISMATCHED_ELEMENT:
-      what = "an element is closed by another name, or not closed";
-      break;
-    case tinyxml2::XML_ERROR_PARSING_TEXT:
-      what = "text where an element was expected";
-      break;
-    case tinyxml2::XML_ERROR_PARSING:
-      what = "an element is not closed before the file ends, or a tag is cut short";
-      break;
-    case tinyxml2::XML_ERROR_PARSING_ELEMENT:
-      what = "an element's tag is malformed";
-      break;
-    case tinyxml2::XML_ERROR_PARSING_COMMENT:
-      what = "a comment is not closed";
-      break;
-    case tinyxml2::XML_ERROR_PARSING_DECLARATION:
-      what = "a declaration or processing instruction is malformed, or stands inside an element";
-      break;
-    default:
-      what = document.ErrorName();
-  }
+  if (document.ErrorID() == tinyxml2::XML_ERROR_EMPTY_DOCUMENT) return "the file is empty (no XML element)";
+  static const std::pair<tinyxml2::XMLError, const char*> kInWords[] = {
+      {tinyxml2::XML_ERROR_PARSING_ATTRIBUTE, "an attribute is not name=\"value\", or is given twice"},
+      {tinyxml2::XML_ERROR_MISMATCHED_ELEMENT, "an element is closed by another name, or not closed"},
+      {tinyxml2::XML_ERROR_PARSING_TEXT, "text where an element was expected"},
+      {tinyxml2::XML_ERROR_PARSING, "an element is not closed before the file ends, or a tag is cut short"},
+      {tinyxml2::XML_ERROR_PARSING_ELEMENT, "an element's tag is malformed"},
+      {tinyxml2::XML_ERROR_PARSING_COMMENT, "a comment is not closed"},
+      {tinyxml2::XML_ERROR_PARSING_DECLARATION,
+       "a declaration or processing instruction is malformed, or stands inside an element"},
+  };
+  const char* what = document.ErrorName();
+  for (const auto& [error, words] : kInWords)
+    if (document.ErrorID() == error) what = words;
   // tinyxml2's own text ends with the element it was reading ("... XMLElement name=mass")
   const std::string detail = document.ErrorStr();
   const std::size_t element = detail.find("XMLElement name=");
