@@ -148,13 +148,15 @@ TEST(Budget, RefusedWhereFlowsPerElementAreNotKept) {
 }
 
 // A label reaches gnuplot as one string whatever it holds: a newline followed by '!' would run a
-// shell command if it ended the string's line; gnuplot prints the label back byte for byte.
+// shell command if it ended the string's line, and so would a command in backquotes; gnuplot
+// prints the label back byte for byte.
 TEST(Budget, PlotLabelsStayStrings) {
   const fs::path dir = fs::temp_directory_path() / "metriplex-gnuplot-label";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path touched = dir / "touched";
-  const std::string label = "a\n!touch " + touched.string() + "\nb \"q\" 'r' \\z\t";
+  const std::string label =
+      "a\n!touch " + touched.string() + "\nb \"q\" 'r' \\z\t `touch " + touched.string() + "` end";
   {
     std::ofstream script(dir / "label.gp");
     script << "set print " << gnuplotQuoted((dir / "printed.txt").string()) << "\nprint " << gnuplotQuoted(label)

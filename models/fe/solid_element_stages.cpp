@@ -174,8 +174,10 @@ class BranchPath {
       : branch_(branch), rule_(rule), column_(column) {
     const Mat3 A0 = greenStrain(path.C0) - gamma[0], AEnd = greenStrain(path.CEnd) - gammaEnd;
     stressEnd_ = branchStressOf(branch, AEnd);
-    // Psi_v is quadratic in A: its change is exact from the mean stress
-    double defect = 0.5 * contract(AEnd - A0, branchStressOf(branch, AEnd + A0)), norm = 0.0;
+    // Psi_v is quadratic in A: its change is exact from the mean stress, and A's change comes from
+    // C's change (not AEnd - A0), so that its round-off is in proportion to the motion
+    const Mat3 AChange = 0.5 * path.CChange - (gammaEnd - gamma[0]);
+    double defect = 0.5 * contract(AChange, branchStressOf(branch, AEnd + A0)), norm = 0.0;
     for (int j = 0; j < rule.stages; ++j) {
       A_[j] = greenStrain(path.C[j]) - gamma[j + 1];
       rate_[j] = 0.5 * path.strainRate[j] - gammaRate[j];

@@ -253,14 +253,17 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
     out.dForce.setZero(n, n);
     out.dForceDLambda = out.rateRow = ConstraintVector::Zero(n);
   }
-  // With a multiplier, the force (lambda + kappa (Phi_0 + Phi_end) / 2) grad Phi takes grad Phi on
-  // the stages' line y, whose moment y x grad Phi(y) vanishes pointwise for a rotation-invariant
-  // Phi; the penalty's mean over the step's ends is its discrete gradient in Phi. A penalty alone
-  // takes kappa Phi grad Phi on the path, whose change of kappa/2 Phi^2 is exact (section 13.7).
+  // Under the augmented Lagrangian the force (lambda + kappa (Phi_0 + Phi_end) / 2) grad Phi takes
+  // grad Phi on the stages' line y, whose moment y x grad Phi(y) vanishes pointwise for the
+  // rigidity's forms (section 13.7); the penalty's mean over the step's ends is its discrete
+  // gradient in Phi (lambda = 0 on an implied form). A penalty alone takes kappa Phi grad Phi on
+  // the path, whose change of kappa/2 Phi^2 is exact.
+  const bool onLine = augmented();
   double lambda[CollocationRule::kMostStages] = {}, meanPenalty = 0.0;
   SupportValues endGradient{};
-  if (out.lambdaUnknown) {
+  if (out.lambdaUnknown)
     for (int j = 0; j < rule.stages; ++j) lambda[j] = args.stageState[j][spec_.firstMultiplierDof + k];
+  if (onLine) {
     const double phiEnd = form.valueAndSupportGradient(path.end, endGradient);
     meanPenalty = 0.5 * spec_.stiffness * (form.valueAt(path.start) + phiEnd);
   }
@@ -269,7 +272,7 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
     double value = meanPenalty;
     for (int j = 0; j < rule.stages; ++j) value += rule.fineStage[p][j] * lambda[j];
     SupportValues gradientHere;
-    if (out.lambdaUnknown)
+    if (onLine)
       form.valueAndSupportGradient(path.line[p], gradientHere);
     else
       value = spec_.stiffness * form.valueAndSupportGradient(path.q[p], gradientHere);
@@ -280,7 +283,7 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
       for (int s = 0; s < supportSize; ++s) out.force[i][s] += (test * value) * gradientHere[s];
       out.rateOfPhi[i] += test * rateOfPhiHere;
       if (!args.tangent) continue;
-      if (!out.lambdaUnknown) {
+      if (!onLine) {
         // d q / d Z_column at this point
         const double valueCoefficient = rule.fineValue[p][column + 1];
         out.hessianWeight += test * valueCoefficient * value;
@@ -290,14 +293,15 @@ QuadraticConstraint::StageProjection QuadraticConstraint::project(std::size_t k,
       // d y / d Z_column at this point
       const double lineCoefficient = rule.fineStage[p][column];
       out.hessianWeight += test * lineCoefficient * value;
+      lineForce += test * gradient;
+      if (!out.lambdaUnknown) continue;
       out.dForceDLambda += (test * lineCoefficient) * gradient;
       out.rateRow +=
           test * (lineCoefficient * form.hessianTimes(path.rate[p]) + rule.fineRate[p][column + 1] * gradient);
-      lineForce += test * gradient;
     }
   }
   // the mean penalty's change with the step's end
-  if (args.tangent && out.lambdaUnknown)
+  if (args.tangent && onLine)
     out.dForce.noalias() +=
         (0.5 * spec_.stiffness * rule.end[column + 1]) * lineForce * form.fromSupport(endGradient).transpose();
   return out;

@@ -16,21 +16,20 @@ namespace mpx {
 
 namespace {
 
-// A word of the file as a message quotes it: bytes outside printable ASCII as \xHH (a binary
-// file's would garble the terminal), at most 40 of them.
-std::string shown(const std::string& text) {
+// The file's text as a message quotes it: bytes outside printable ASCII as \xHH (a binary
+// file's would garble the terminal).
+std::string printable(const std::string& text) {
+  static const char* digits = "0123456789abcdef";
   std::string out;
-  for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 40); ++i) {
-    const auto byte = static_cast<unsigned char>(text[i]);
-    if (byte >= 0x20 && byte < 0x7f) {
-      out += text[i];
-    } else {
-      static const char* digits = "0123456789abcdef";
-      out += std::string("\\x") + digits[byte >> 4] + digits[byte & 15];
-    }
+  for (char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    out += byte >= 0x20 && byte < 0x7f ? std::string(1, c) : std::string("\\x") + digits[byte >> 4] + digits[byte & 15];
   }
-  return text.size() > 40 ? out + "..." : out;
+  return out;
 }
+
+// A word of the file in a message: its first 40 bytes.
+std::string shown(const std::string& text) { return text.size() > 40 ? text.substr(0, 40) + "..." : text; }
 
 // What Gmsh element types are: nodes per element and dimension (the first- and second-order types 1..19).
 struct ElementKind {
@@ -117,7 +116,7 @@ class SectionReader {
     char* end = nullptr;
     const double value = std::strtod(token.text.c_str(), &end);
     if (*end) fail(token.line, "expected " + what + " (a number), found '" + shown(token.text) + "'");
-    if (!std::isfinite(value)) fail(token.line, what + " is '" + token.text + "', not a finite number");
+    if (!std::isfinite(value)) fail(token.line, what + " is '" + shown(token.text) + "', not a finite number");
     return value;
   }
 
@@ -131,11 +130,13 @@ class SectionReader {
   // All words must have been read: extra data means a count in the section is too small.
   void finish() const {
     if (position_ < tokens_.size())
-      fail(tokens_[position_].line, "unexpected '" + tokens_[position_].text + "' before $End" + name_ +
+      fail(tokens_[position_].line, "unexpected '" + shown(tokens_[position_].text) + "' before $End" + name_ +
                                         " (a count is too small or there is extra data)");
   }
 
-  [[noreturn]] void fail(int line, const std::string& message) const { throw InputError(file_, line, message); }
+  [[noreturn]] void fail(int line, const std::string& message) const {
+    throw InputError(file_, line, printable(message));
+  }
 
  private:
   std::string file_, name_;
@@ -200,7 +201,9 @@ class GmshParser {
   }
 
  private:
-  [[noreturn]] void fail(int line, const std::string& message) const { throw InputError(path_, line, message); }
+  [[noreturn]] void fail(int line, const std::string& message) const {
+    throw InputError(path_, line, printable(message));
+  }
 
   static std::string trimmed(const std::string& text) {
     const size_t first = text.find_first_not_of(" \t\r");

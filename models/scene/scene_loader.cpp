@@ -72,7 +72,8 @@ void setMechanicalScales(SceneBuild& build, double tEnd) {
   }
 }
 
-// The initial state must give finite measures and positive temperatures: a value that overflows
+// The initial state must give finite measures (those the history writes) and positive
+// temperatures: a value that overflows
 // (a mass of 1e308 moving at 1e308) or an entropy beyond what a capacity's temperature can
 // represent would otherwise only fail in the first step. Names the element whose measure fails.
 void checkInitialState(const Model& model, const SceneSpec& scene,
@@ -83,10 +84,12 @@ void checkInitialState(const Model& model, const SceneSpec& scene,
     component->measure(model.initialState().data(), own);
     const bool temperaturesPositive = std::all_of(own.nodeTemperature.begin(), own.nodeTemperature.end(),
                                                   [](double t) { return t > 0.0 && std::isfinite(t); });
-    if (std::isfinite(own.energy) && std::isfinite(own.entropy) && temperaturesPositive) continue;
+    if (std::isfinite(own.energy) && std::isfinite(own.entropy) && own.momentum.allFinite() &&
+        own.angularMomentum.allFinite() && std::isfinite(own.constraintViolation) && temperaturesPositive)
+      continue;
     ElementReader(scene.elements[elementIndex.at(component.get())])
-        .fail(fmt::format("the initial state gives energy {:.3g}, entropy {:.3g} or a temperature that is not finite "
-                          "and positive",
+        .fail(fmt::format("the initial state gives energy {:.3g}, entropy {:.3g}, a momentum, a constraint violation "
+                          "or a temperature that is not finite (a temperature: and positive)",
                           own.energy, own.entropy));
   }
 }

@@ -144,7 +144,7 @@ std::string malformedXml(const tinyxml2::XMLDocument& document) {
       {tinyxml2::XML_ERROR_PARSING_ELEMENT, "an element's tag is malformed"},
       {tinyxml2::XML_ERROR_PARSING_COMMENT, "a comment is not closed"},
       {tinyxml2::XML_ERROR_PARSING_DECLARATION,
-       "a declaration or processing instruction is malformed, or stands inside an element"},
+       "a declaration or processing instruction is malformed, or stands inside or after the root element"},
   };
   const char* what = document.ErrorName();
   for (const auto& [error, words] : kInWords)

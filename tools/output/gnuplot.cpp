@@ -22,13 +22,14 @@ std::string shellQuoted(const std::string& text) {
 
 std::string gnuplotQuoted(const std::string& text) {
   // a newline would end the command inside the string and start another (gnuplot runs a line
-  // that starts with '!' in the shell); in double quotes gnuplot reads octal escapes instead
+  // that starts with '!' in the shell), and gnuplot runs `...` in the shell even inside double
+  // quotes; in double quotes it reads octal escapes instead of both
   std::string quoted = "\"";
   for (char c : text) {
     const auto byte = static_cast<unsigned char>(c);
     if (c == '"' || c == '\\')
       quoted += std::string("\\") + c;
-    else if (byte < 0x20 || byte == 0x7f)
+    else if (byte < 0x20 || byte == 0x7f || c == '`')
       quoted += fmt::format("\\{:03o}", byte);
     else
       quoted += c;

@@ -7,7 +7,7 @@
 namespace mpx {
 
 // Text as a double-quoted gnuplot string: quotes and backslashes escaped, control characters
-// (a newline would start a new command) as octal escapes.
+// (a newline would start a new command) and backquotes (command substitution) as octal escapes.
 std::string gnuplotQuoted(const std::string& text);
 
 // Run gnuplot on `script`, its stderr into `log`. Throws std::runtime_error with the log's
