@@ -73,9 +73,9 @@ void setMechanicalScales(SceneBuild& build, double tEnd) {
 }
 
 // The initial state must give finite measures (those the history writes) and positive
-// temperatures: a value that overflows
-// (a mass of 1e308 moving at 1e308) or an entropy beyond what a capacity's temperature can
-// represent would otherwise only fail in the first step. Names the element whose measure fails.
+// temperatures: a value that overflows (a mass of 1e308 moving at 1e308) or an entropy beyond
+// what a capacity's temperature can represent would otherwise only fail in the first step.
+// Names the element whose measure fails.
 void checkInitialState(const Model& model, const SceneSpec& scene,
                        const std::map<const Component*, std::size_t>& elementIndex) {
   for (const auto& component : model.components()) {
@@ -88,8 +88,8 @@ void checkInitialState(const Model& model, const SceneSpec& scene,
         own.angularMomentum.allFinite() && std::isfinite(own.constraintViolation) && temperaturesPositive)
       continue;
     ElementReader(scene.elements[elementIndex.at(component.get())])
-        .fail(fmt::format("the initial state gives energy {:.3g}, entropy {:.3g}, a momentum, a constraint violation "
-                          "or a temperature that is not finite (a temperature: and positive)",
+        .fail(fmt::format("the initial state gives a measure that is not finite or a temperature that is not "
+                          "positive (energy {:.3g}, entropy {:.3g})",
                           own.energy, own.entropy));
   }
 }
