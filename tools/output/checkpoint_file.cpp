@@ -86,14 +86,26 @@ class FieldReader {
  public:
   FieldReader(std::string path, const std::string& text) : path_(std::move(path)), text_(text) {}
 
-  void operator()(const std::string& key, std::string& value) { value = word(next(key)), endOfLine(key); }
-  void operator()(const std::string& key, bool& value) { value = integer(next(key), 0, 1) == 1, endOfLine(key); }
+  void operator()(const std::string& key, std::string& value) {
+    value = word(next(key));
+    endOfLine(key);
+  }
+  void operator()(const std::string& key, bool& value) {
+    value = integer(next(key), 0, 1) == 1;
+    endOfLine(key);
+  }
   void operator()(const std::string& key, int& value) {
     value = static_cast<int>(integer(next(key), 0, INT32_MAX));
     endOfLine(key);
   }
-  void operator()(const std::string& key, long& value) { value = integer(next(key), 0, INT64_MAX), endOfLine(key); }
-  void operator()(const std::string& key, double& value) { value = number(next(key)), endOfLine(key); }
+  void operator()(const std::string& key, long& value) {
+    value = integer(next(key), 0, INT64_MAX);
+    endOfLine(key);
+  }
+  void operator()(const std::string& key, double& value) {
+    value = number(next(key));
+    endOfLine(key);
+  }
   // a state vector holds every dof, or none (fixed steps keep no error history)
   void operator()(const std::string& key, Eigen::VectorXd& values) {
     std::istringstream& line = next(key);
@@ -119,8 +131,9 @@ class FieldReader {
     std::string line;
     do {
       if (!std::getline(text_, line)) {
-        if (line_ == 0) ++line_, fail("the file is empty");
-        fail("the file ends before field '" + key + "'");
+        if (line_ > 0) fail("the file ends before field '" + key + "'");
+        line_ = 1;
+        fail("the file is empty");
       }
       ++line_;
     } while (!line.empty() && line[0] == '#');
