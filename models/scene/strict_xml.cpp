@@ -12,6 +12,9 @@ namespace mpx {
 
 namespace {
 
+// No element of a scene or a URDF has more than a few dozen attributes.
+constexpr int kMostAttributes = 1000;
+
 // A scan of the raw text for what the parser would accept silently; it tracks lines and whether
 // it is in character data, inside a tag or inside a quoted attribute value.
 class XmlTextCheck {
@@ -21,6 +24,7 @@ class XmlTextCheck {
   void run() {
     enum class State { Text, Tag, Value } state = State::Text;
     char quote = 0;
+    int attributes = 0;  // of the tag being read
     for (; i_ < text_.size(); ++i_) {
       const char c = text_[i_];
       if (c == '\n') ++line_;
@@ -36,11 +40,17 @@ class XmlTextCheck {
           fail("document type declarations are not supported (their entities would not be expanded)");
         } else if (c == '<') {
           state = State::Tag;
+          attributes = 0;
         } else if (c == '&') {
           checkReference();
         }
       } else if (state == State::Tag) {
-        if (c == '"' || c == '\'') state = State::Value, quote = c;
+        if (c == '"' || c == '\'') {
+          state = State::Value, quote = c;
+          // tinyxml2 checks each attribute against all before it, which takes minutes at 1e5
+          if (++attributes > kMostAttributes)
+            fail("an element with more than " + std::to_string(kMostAttributes) + " attributes");
+        }
         if (c == '>') state = State::Text;
       } else if (c == quote) {
         state = State::Tag;
