@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -134,6 +136,13 @@ struct Measures {
   double constraintViolation = 0.0;
   std::vector<double> nodeTemperature;  // one entry per thermal node
 };
+
+// Every measure the history writes is finite.
+inline bool finite(const Measures& m) {
+  return std::isfinite(m.energy) && std::isfinite(m.entropy) && std::isfinite(m.constraintViolation) &&
+         m.momentum.allFinite() && m.angularMomentum.allFinite() &&
+         std::all_of(m.nodeTemperature.begin(), m.nodeTemperature.end(), [](double t) { return std::isfinite(t); });
+}
 
 class Component {
  public:

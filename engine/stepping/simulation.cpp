@@ -73,13 +73,6 @@ namespace {
 std::atomic<bool> stopRequest{false};
 static_assert(std::atomic<bool>::is_always_lock_free);
 
-// every measure the history writes
-bool finite(const Measures& m) {
-  return std::isfinite(m.energy) && std::isfinite(m.entropy) && std::isfinite(m.constraintViolation) &&
-         m.momentum.allFinite() && m.angularMomentum.allFinite() &&
-         std::all_of(m.nodeTemperature.begin(), m.nodeTemperature.end(), [](double t) { return std::isfinite(t); });
-}
-
 bool finite(const Flows& f) {
   return std::isfinite(f.dissipated) && std::isfinite(f.externalWork) && std::isfinite(f.boundaryHeat) &&
          std::isfinite(f.boundaryEntropy);

@@ -231,7 +231,8 @@ QuadraticConstraint::StagePath QuadraticConstraint::stagePath(const StageArgs& a
       path.q[p] += rule.fineValue[p][j] * basis[j];
       path.rate[p] += rule.fineRate[p][j] * basis[j];
     }
-    for (int j = 0; j < rule.stages; ++j) path.line[p] += rule.fineStage[p][j] * basis[j + 1];
+    if (augmented())
+      for (int j = 0; j < rule.stages; ++j) path.line[p] += rule.fineStage[p][j] * basis[j + 1];
     for (int i = 0; i < count; ++i) {
       const int l = firstStage + i;
       path.testWeight[p][i] = rule.fineWeight[p] * rule.fineStage[p][l] / rule.weight[l];

@@ -1,8 +1,5 @@
 #include "models/scene/element_reader.hpp"
 
-#include <fmt/format.h>
-
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -11,12 +8,7 @@ namespace mpx {
 
 std::string echoed(const std::string& value) {
   constexpr std::size_t kLongest = 64;
-  // a control character shows as \xHH, so that a message stays one line of plain text
-  std::string shown;
-  for (std::size_t i = 0; i < std::min(value.size(), kLongest); ++i) {
-    const auto byte = static_cast<unsigned char>(value[i]);
-    shown += byte < 0x20 || byte == 0x7f ? fmt::format("\\x{:02x}", byte) : std::string(1, value[i]);
-  }
+  const std::string shown = printable(value.substr(0, kLongest));
   if (value.size() <= kLongest) return shown;
   return shown + "... (" + std::to_string(value.size()) + " characters)";
 }

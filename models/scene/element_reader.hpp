@@ -13,7 +13,7 @@
 namespace mpx {
 
 // A value as quoted in a message: whole up to 64 characters, else its start and its length;
-// control characters as \xHH.
+// bytes outside printable ASCII as \xHH (printable).
 std::string echoed(const std::string& value);
 
 class ElementReader {

@@ -16,18 +16,6 @@ namespace mpx {
 
 namespace {
 
-// The file's text as a message quotes it: bytes outside printable ASCII as \xHH (a binary
-// file's would garble the terminal).
-std::string printable(const std::string& text) {
-  static const char* digits = "0123456789abcdef";
-  std::string out;
-  for (char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    out += byte >= 0x20 && byte < 0x7f ? std::string(1, c) : std::string("\\x") + digits[byte >> 4] + digits[byte & 15];
-  }
-  return out;
-}
-
 // A word of the file in a message: its first 40 bytes.
 std::string shown(const std::string& text) { return text.size() > 40 ? text.substr(0, 40) + "..." : text; }
 
